@@ -1,0 +1,60 @@
+//! Generators: algorithms that emit schedules of real moves.
+//!
+//! Each generator implements [`Generator`] and is listed in [`registry`];
+//! a scenario file names one by its [`Generator::name`]. Generators depend
+//! on the lattice and schedule layers only, never on certification.
+
+pub mod random_walk;
+pub mod schedule_file;
+
+use crate::error::InputError;
+use crate::scenario::Scenario;
+use crate::schedule::Schedule;
+use serde::de::DeserializeOwned;
+
+/// An algorithm that turns a scenario into a schedule.
+pub trait Generator: Sync {
+    /// The name scenario files use in `algorithm = "…"`.
+    fn name(&self) -> &'static str;
+    /// One line on what it generates.
+    fn about(&self) -> &'static str;
+    fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError>;
+}
+
+/// Every generator this build knows.
+pub fn registry() -> Vec<&'static dyn Generator> {
+    vec![&schedule_file::ScheduleFile, &random_walk::RandomWalk]
+}
+
+/// Finds the generator a scenario names.
+pub fn find(name: &str) -> Result<&'static dyn Generator, String> {
+    registry()
+        .into_iter()
+        .find(|g| g.name() == name)
+        .ok_or_else(|| {
+            let known: Vec<_> = registry().iter().map(|g| g.name()).collect();
+            format!("unknown algorithm '{name}' (known: {})", known.join(", "))
+        })
+}
+
+/// Runs the generator named by the scenario.
+pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
+    let g = find(&scenario.algorithm).map_err(|e| scenario.error(e))?;
+    let mut s = g.generate(scenario)?;
+    s.meta
+        .entry("scenario".into())
+        .or_insert_with(|| scenario.name.clone().into());
+    if s.model.is_none() {
+        s.model = scenario.model.clone();
+    }
+    Ok(s)
+}
+
+/// Reads a generator's parameters from the scenario's `[parameters]` table.
+pub fn parameters<P: DeserializeOwned>(scenario: &Scenario) -> Result<P, InputError> {
+    scenario
+        .parameters
+        .clone()
+        .try_into()
+        .map_err(|e| scenario.error(format!("bad [parameters] for '{}': {e}", scenario.algorithm)))
+}

@@ -1,0 +1,165 @@
+//! Synthetic workload: catoms rolling at random over a fixed FCC platform.
+//!
+//! Used by property tests (random valid walks must certify clean) and by
+//! the benchmarks (large schedules of many concurrent movers). Walkers stay
+//! in layer 1, rolling over the platform modules of layer 0, so every
+//! walker is held by a fixed pivot and the static structure stays anchored.
+
+use super::{parameters, Generator};
+use crate::error::InputError;
+use crate::lattice::config::{Configuration, Ground, ModuleId};
+use crate::lattice::{fcc, Cell, FccLattice, Lattice, LatticeKind, Motion, Route};
+use crate::scenario::Scenario;
+use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashSet;
+use serde::Deserialize;
+
+/// Parameters of a random walk.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkParams {
+    /// Platform size in cells along x and y.
+    pub width: i32,
+    pub depth: i32,
+    /// Number of walking catoms.
+    pub walkers: usize,
+    pub steps: usize,
+    /// Probability that a walker tries to move in a step.
+    #[serde(default = "default_activity")]
+    pub activity: f64,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn default_activity() -> f64 {
+    0.5
+}
+
+/// Decides whether a candidate move may be taken, given the configuration
+/// at the start of the step and the moves already chosen for it. The
+/// default accepts every lattice-valid move; callers plug in geometric
+/// motion rules.
+pub type MoveFilter<'a> = dyn Fn(&Configuration, &Motion, &[Motion]) -> bool + 'a;
+
+/// The random-walk generator.
+pub struct RandomWalk;
+
+impl Generator for RandomWalk {
+    fn name(&self) -> &'static str {
+        "random-walk"
+    }
+
+    fn about(&self) -> &'static str {
+        "catoms rolling at random over a fixed platform (synthetic workload)"
+    }
+
+    fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
+        let p: WalkParams = parameters(scenario)?;
+        if p.width < 2 || p.depth < 2 {
+            return Err(scenario.error("random-walk needs a platform of at least 2 × 2"));
+        }
+        if p.walkers > ((p.width - 1) * (p.depth - 1)) as usize {
+            return Err(scenario.error(format!(
+                "{} walkers do not fit on a {} × {} platform",
+                p.walkers, p.width, p.depth
+            )));
+        }
+        Ok(walk(&p, &|_, _, _| true))
+    }
+}
+
+/// Generates a random walk whose moves all pass `filter`.
+pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
+    let l = FccLattice;
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+    s.ground = Some(Ground { layer: 0 });
+    s.meta.insert("algorithm".into(), "random-walk".into());
+    s.meta.insert("seed".into(), p.seed.into());
+    let mut config = Configuration::new();
+    let mut id: ModuleId = 0;
+    for x in 0..p.width {
+        for y in 0..p.depth {
+            let c = Cell::new(x, y, 0);
+            s.modules.push(ModuleSpec { id, cell: c, fixed: true });
+            config.insert(id, c).expect("distinct cells");
+            id += 1;
+        }
+    }
+    let platform: FxHashSet<Cell> = config.iter().map(|(_, c)| c).collect();
+    // Layer-1 cells resting on four platform modules.
+    let mut spots: Vec<Cell> = (0..p.width - 1)
+        .flat_map(|x| (0..p.depth - 1).map(move |y| Cell::new(x, y, 1)))
+        .collect();
+    spots.shuffle(&mut rng);
+    let mut walkers = Vec::new();
+    for &c in spots.iter().take(p.walkers) {
+        s.modules.push(ModuleSpec { id, cell: c, fixed: false });
+        config.insert(id, c).expect("distinct cells");
+        walkers.push(id);
+        id += 1;
+    }
+
+    for _ in 0..p.steps {
+        walkers.shuffle(&mut rng);
+        let mut chosen: Vec<Motion> = Vec::new();
+        let mut events = Vec::new();
+        let mut claimed: FxHashSet<Cell> = FxHashSet::default();
+        let mut leaving: FxHashSet<Cell> = FxHashSet::default();
+        for &w in &walkers {
+            if !rng.random_bool(p.activity) {
+                continue;
+            }
+            let from = config.cell_of(w).expect("walkers stay in the scene");
+            // Down-neighbours (connectors 8..12) that are platform modules.
+            let mut pivots: Vec<Cell> = (8..12)
+                .map(|k| l.neighbour(from, k))
+                .filter(|c| platform.contains(c))
+                .collect();
+            pivots.shuffle(&mut rng);
+            let Some(&pivot) = pivots.first() else { continue };
+            let mut targets: Vec<Cell> = (4..8)
+                .map(|k| l.neighbour(pivot, k))
+                .filter(|&t| {
+                    t != from
+                        && config.is_free(t)
+                        && !claimed.contains(&t)
+                        && !leaving.contains(&t)
+                })
+                .collect();
+            targets.shuffle(&mut rng);
+            for to in targets {
+                let n_f = (l.centre(from) - l.centre(pivot)).normalize();
+                let n_t = (l.centre(to) - l.centre(pivot)).normalize();
+                let routes: &[Route] = if fcc::rotation_axis(n_f, n_t, Route::Hexagonal).is_some() {
+                    &[Route::Octagonal, Route::Hexagonal]
+                } else {
+                    &[Route::Octagonal]
+                };
+                let route = routes[rng.random_range(0..routes.len())];
+                let m = Motion::Rotate { from, to, pivot, route };
+                if !filter(&config, &m, &chosen) {
+                    continue;
+                }
+                let pivot_id = config.at(pivot).expect("platform pivot");
+                events.push(Event::Rotate { module: w, pivot: pivot_id, from, to, route });
+                claimed.insert(to);
+                leaving.insert(from);
+                chosen.push(m);
+                break;
+            }
+        }
+        for e in &events {
+            if let Event::Rotate { module, to, .. } = e {
+                config.remove(*module);
+                config.insert(*module, *to).expect("claimed targets are distinct");
+            }
+        }
+        events.sort_by_key(Event::module);
+        s.steps.push(Step { events });
+    }
+    s
+}

@@ -1,0 +1,176 @@
+//! Certification: replays a schedule step by step and runs every check on
+//! every step.
+//!
+//! Checks implement [`StepCheck`]; the lattice checks always run, geometric
+//! and mechanical checks join them where the lattice has a model for them.
+
+pub mod lattice_check;
+pub mod report;
+pub mod world;
+
+pub use lattice_check::LatticeCheck;
+pub use report::{Report, StepResult, Violation, ViolationKind};
+pub use world::{Move, StepPlan, World};
+
+use crate::error::InputError;
+use crate::schedule::Schedule;
+use std::collections::BTreeMap;
+
+/// Certification options.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Name of the schedule in the report (usually its path).
+    pub name: String,
+    /// Show a progress bar on standard error for long schedules.
+    pub progress: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            name: "schedule".into(),
+            progress: false,
+        }
+    }
+}
+
+/// What a check sees of one step: the scene before it and the step's moves.
+pub struct StepContext<'a> {
+    pub world: &'a World,
+    pub plan: &'a StepPlan,
+}
+
+/// Findings of the checks on one step.
+#[derive(Debug, Default)]
+pub struct StepOutcome {
+    pub violations: Vec<Violation>,
+    pub warnings: Vec<Violation>,
+    pub metrics: BTreeMap<String, f64>,
+}
+
+/// One kind of check, run on every step of a schedule.
+pub trait StepCheck: Send + Sync {
+    /// Short name listed in the report.
+    fn name(&self) -> &'static str;
+    /// Examines one step; `ctx.world` is the scene at the start of the step.
+    fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome);
+    /// Examines the final configuration (after the last step).
+    fn check_final(&self, world: &World, step: usize, out: &mut StepOutcome) {
+        let _ = (world, step, out);
+    }
+}
+
+/// Certifies `schedule` with the lattice checks only.
+pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError> {
+    certify_with(schedule, opts, &[&LatticeCheck])
+}
+
+/// Certifies `schedule` with the given checks. Input errors (not a schedule
+/// this lattice can execute) abort; violations are collected in the report.
+pub fn certify_with(
+    schedule: &Schedule,
+    opts: &Options,
+    checks: &[&dyn StepCheck],
+) -> Result<Report, InputError> {
+    let mut world = World::initial(schedule)?;
+    let mut report = Report {
+        format: report::REPORT_FORMAT.to_string(),
+        version: 1,
+        schedule: opts.name.clone(),
+        lattice: schedule.lattice,
+        modules: schedule.modules.len(),
+        steps: schedule.steps.len(),
+        moves: schedule.move_count(),
+        checks: checks.iter().map(|c| c.name().to_string()).collect(),
+        certified: false,
+        stopped_at: None,
+        violations: Vec::new(),
+        warnings: Vec::new(),
+        per_step: Vec::with_capacity(schedule.steps.len()),
+    };
+    let bar = progress_bar(opts, schedule.steps.len());
+
+    // The initial configuration must stand on its own.
+    let nobody = Default::default();
+    let loose = world.unanchored(&nobody);
+    if !loose.is_empty() {
+        report.violations.push(
+            Violation::new(
+                ViolationKind::Disconnected,
+                0,
+                format!("the initial configuration has {} module(s) not connected to the ground", loose.len()),
+            )
+            .modules(loose),
+        );
+    }
+
+    for (k, step) in schedule.steps.iter().enumerate() {
+        let index = k + 1;
+        let plan = world.resolve(index, step)?;
+        let mut out = StepOutcome {
+            violations: plan.violations.clone(),
+            ..Default::default()
+        };
+        let ctx = StepContext {
+            world: &world,
+            plan: &plan,
+        };
+        for c in checks {
+            c.check(&ctx, &mut out);
+        }
+        let clashes = world.apply(&plan);
+        let stop = !clashes.is_empty();
+        out.violations.extend(clashes);
+        report.per_step.push(StepResult {
+            step: index,
+            moves: plan.moves.len(),
+            violations: out.violations.len(),
+            warnings: out.warnings.len(),
+            metrics: out.metrics,
+        });
+        report.violations.extend(out.violations);
+        report.warnings.extend(out.warnings);
+        bar.inc(1);
+        if stop {
+            report.stopped_at = Some(index);
+            break;
+        }
+    }
+    bar.finish_and_clear();
+
+    if report.stopped_at.is_none() {
+        let final_step = schedule.steps.len() + 1;
+        let loose = world.unanchored(&nobody);
+        if !loose.is_empty() {
+            report.violations.push(
+                Violation::new(
+                    ViolationKind::Disconnected,
+                    final_step,
+                    format!("the final configuration has {} module(s) not connected to the ground", loose.len()),
+                )
+                .modules(loose),
+            );
+        }
+        let mut out = StepOutcome::default();
+        for c in checks {
+            c.check_final(&world, final_step, &mut out);
+        }
+        report.violations.extend(out.violations);
+        report.warnings.extend(out.warnings);
+    }
+    report.certified = report.violations.is_empty() && report.stopped_at.is_none();
+    Ok(report)
+}
+
+fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    if !opts.progress || steps < 50 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})")
+            .expect("valid template"),
+    );
+    bar
+}

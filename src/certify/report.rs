@@ -1,0 +1,195 @@
+//! Certification results: typed violations, per-step results, and the two
+//! renderings (JSON for machines, a summary for people).
+
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Cell, LatticeKind};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// What went wrong (or, for warnings, what deserves a look).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ViolationKind {
+    /// Two modules in one cell at the end of a step (or a blocked entry).
+    Occupancy,
+    /// The pivot named by a move is not in the scene.
+    PivotMissing,
+    /// The pivot moves in the same step as the module rolling on it.
+    PivotMoving,
+    /// The mover is not held: its latch to the pivot is released, or a
+    /// support the move needs (wall, corner, ground) is absent or moving.
+    MoverDetached,
+    /// A cell the move sweeps through is occupied.
+    PassageBlocked,
+    /// The static structure is not connected to the ground/anchors.
+    Disconnected,
+    /// A module is given more than one move in one time step.
+    MultipleMoves,
+    /// A module enters somewhere other than a source cell.
+    NotASource,
+    /// A module leaves from somewhere other than a sink cell.
+    NotASink,
+    /// An attach/detach between modules that are not neighbours.
+    LatchNotAdjacent,
+    /// Two module bodies interpenetrate during a sweep (geometry check).
+    Collision,
+    /// A mover slides in contact with a module that is not its pivot.
+    SlidingContact,
+    /// The structure has no static equilibrium under gravity.
+    Unstable,
+    /// A connector load exceeds its capacity.
+    Overload,
+}
+
+impl ViolationKind {
+    pub fn name(self) -> String {
+        serde_json::to_value(self)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_owned))
+            .unwrap_or_default()
+    }
+}
+
+/// One finding of a check.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Violation {
+    pub kind: ViolationKind,
+    /// Time step (1-based); `steps + 1` is the final configuration.
+    pub step: usize,
+    pub modules: Vec<ModuleId>,
+    pub cells: Vec<Cell>,
+    pub message: String,
+    /// Check-specific numbers (sweep parameter, depth, witness points, load).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub detail: BTreeMap<String, serde_json::Value>,
+}
+
+impl Violation {
+    pub fn new(kind: ViolationKind, step: usize, message: impl Into<String>) -> Self {
+        Violation {
+            kind,
+            step,
+            modules: Vec::new(),
+            cells: Vec::new(),
+            message: message.into(),
+            detail: BTreeMap::new(),
+        }
+    }
+
+    pub fn modules(mut self, m: impl IntoIterator<Item = ModuleId>) -> Self {
+        self.modules.extend(m);
+        self
+    }
+
+    pub fn cells(mut self, c: impl IntoIterator<Item = Cell>) -> Self {
+        self.cells.extend(c);
+        self
+    }
+
+    pub fn detail(mut self, key: &str, value: impl Serialize) -> Self {
+        self.detail.insert(
+            key.to_string(),
+            serde_json::to_value(value).expect("detail serialises"),
+        );
+        self
+    }
+}
+
+/// Results of one step.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepResult {
+    pub step: usize,
+    pub moves: usize,
+    pub violations: usize,
+    pub warnings: usize,
+    /// Check-specific figures: e.g. `max_utilisation`, `min_clearance`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub metrics: BTreeMap<String, f64>,
+}
+
+/// The certificate (or its refusal) for one schedule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    pub format: String,
+    pub version: u32,
+    pub schedule: String,
+    pub lattice: LatticeKind,
+    pub modules: usize,
+    pub steps: usize,
+    pub moves: usize,
+    /// Names of the checks that were run.
+    pub checks: Vec<String>,
+    pub certified: bool,
+    /// Set when a violation left the state undefined (two modules in one
+    /// cell) and later steps could not be checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped_at: Option<usize>,
+    pub violations: Vec<Violation>,
+    pub warnings: Vec<Violation>,
+    pub per_step: Vec<StepResult>,
+}
+
+pub const REPORT_FORMAT: &str = "reconfcheck-report";
+
+impl Report {
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("reports serialise")
+    }
+
+    /// Counts of violations by kind.
+    pub fn violation_counts(&self) -> BTreeMap<ViolationKind, usize> {
+        let mut m = BTreeMap::new();
+        for v in &self.violations {
+            *m.entry(v.kind).or_insert(0) += 1;
+        }
+        m
+    }
+
+    /// A readable summary: verdict, counts, the first findings.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let verdict = if self.certified { "CERTIFIED" } else { "NOT CERTIFIED" };
+        let _ = writeln!(
+            s,
+            "{verdict}: {} ({} lattice, {} modules, {} steps, {} moves)",
+            self.schedule,
+            self.lattice.name(),
+            self.modules,
+            self.steps,
+            self.moves
+        );
+        let _ = writeln!(s, "checks: {}", self.checks.join(", "));
+        for (k, n) in self.violation_counts() {
+            let _ = writeln!(s, "  {n:>6} × {}", k.name());
+        }
+        if let Some(k) = self.stopped_at {
+            let _ = writeln!(s, "stopped after step {k}: the state is undefined from there on");
+        }
+        for v in self.violations.iter().take(10) {
+            let _ = writeln!(s, "  step {}: {}: {}", v.step, v.kind.name(), v.message);
+        }
+        if self.violations.len() > 10 {
+            let _ = writeln!(s, "  … {} more violations in the JSON report", self.violations.len() - 10);
+        }
+        if !self.warnings.is_empty() {
+            let _ = writeln!(s, "warnings: {}", self.warnings.len());
+            for w in self.warnings.iter().take(5) {
+                let _ = writeln!(s, "  step {}: {}: {}", w.step, w.kind.name(), w.message);
+            }
+        }
+        let mut metrics: BTreeMap<&str, (f64, usize)> = BTreeMap::new();
+        for r in &self.per_step {
+            for (k, &v) in &r.metrics {
+                let e = metrics.entry(k.as_str()).or_insert((f64::NEG_INFINITY, 0));
+                if v > e.0 {
+                    *e = (v, r.step);
+                }
+            }
+        }
+        for (k, (v, step)) in metrics {
+            let _ = writeln!(s, "max {k}: {v:.4} (step {step})");
+        }
+        s
+    }
+}

@@ -1,0 +1,307 @@
+//! The evolving scene during certification, and the resolution of a step's
+//! events into typed moves against it.
+
+use super::report::{Violation, ViolationKind};
+use crate::error::InputError;
+use crate::lattice::config::{Ground, ModuleId};
+use crate::lattice::{Cell, Configuration, Lattice, Motion, MoveRequirements};
+use crate::schedule::{Event, Schedule, Step};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// The scene between two time steps.
+#[derive(Clone, Debug)]
+pub struct World {
+    pub lattice: &'static dyn Lattice,
+    pub ground: Option<Ground>,
+    pub config: Configuration,
+    pub fixed: FxHashSet<ModuleId>,
+    pub sources: FxHashSet<Cell>,
+    pub sinks: FxHashSet<Cell>,
+    detached: FxHashSet<(ModuleId, ModuleId)>,
+    /// Every id that was ever in the scene, and the step it left at.
+    left_at: FxHashMap<ModuleId, usize>,
+}
+
+fn pair(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
+    (a.min(b), a.max(b))
+}
+
+/// One move of a step, resolved against the scene at the start of the step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Move {
+    pub module: ModuleId,
+    /// The pivot module, where the move names one and it is present.
+    pub pivot: Option<ModuleId>,
+    pub motion: Motion,
+    pub requirements: MoveRequirements,
+    /// False when the pivot is missing: the lattice could not derive the
+    /// move's requirements, and checks that need the pivot skip it.
+    pub pivot_resolved: bool,
+}
+
+/// A step's events, resolved and grouped.
+#[derive(Clone, Debug, Default)]
+pub struct StepPlan {
+    /// 1-based time step.
+    pub step: usize,
+    pub moves: Vec<Move>,
+    pub enters: Vec<(ModuleId, Cell)>,
+    pub leaves: Vec<ModuleId>,
+    pub attaches: Vec<(ModuleId, ModuleId)>,
+    pub detaches: Vec<(ModuleId, ModuleId)>,
+    /// Modules that are not static during the step (movers and leavers).
+    pub moving: FxHashSet<ModuleId>,
+    /// Violations found while resolving (missing pivots, double moves).
+    pub violations: Vec<Violation>,
+}
+
+impl World {
+    /// The initial scene of a schedule. Errors are input errors: duplicate
+    /// ids, two modules in one cell, cells that are not on the lattice or
+    /// inside the ground.
+    pub fn initial(s: &Schedule) -> Result<World, InputError> {
+        let lattice = s.lattice.lattice();
+        let mut world = World {
+            lattice,
+            ground: s.ground,
+            config: Configuration::new(),
+            fixed: FxHashSet::default(),
+            sources: s.sources.iter().copied().collect(),
+            sinks: s.sinks.iter().copied().collect(),
+            detached: FxHashSet::default(),
+            left_at: FxHashMap::default(),
+        };
+        for m in &s.modules {
+            let err = |msg: String| InputError::new(msg).at_step(0).for_module(m.id);
+            world.check_cell(m.cell).map_err(err)?;
+            if world.config.contains(m.id) {
+                return Err(err(format!("module id {} is declared twice", m.id)));
+            }
+            if let Err(other) = world.config.insert(m.id, m.cell) {
+                return Err(err(format!(
+                    "two modules in one cell: {} and {other} are both at {}",
+                    m.id, m.cell
+                )));
+            }
+            if m.fixed {
+                world.fixed.insert(m.id);
+            }
+        }
+        for c in s.sources.iter().chain(&s.sinks) {
+            lattice
+                .check_cell(*c)
+                .map_err(|e| InputError::new(format!("source/sink: {e}")))?;
+        }
+        Ok(world)
+    }
+
+    fn check_cell(&self, c: Cell) -> Result<(), String> {
+        self.lattice.check_cell(c)?;
+        if let Some(g) = self.ground {
+            if g.is_ground_cell(self.lattice, c) {
+                return Err(format!("cell {c} is inside the ground (below layer {})", g.layer));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn latched(&self, a: ModuleId, b: ModuleId) -> bool {
+        !self.detached.contains(&pair(a, b))
+    }
+
+    /// Whether cell `c` holds a module that can bear on a mover during a
+    /// step: a module that is not moving, or the ground.
+    pub fn is_support(&self, c: Cell, moving: &FxHashSet<ModuleId>) -> bool {
+        if self.ground.is_some_and(|g| g.is_ground_cell(self.lattice, c)) {
+            return true;
+        }
+        self.config.at(c).is_some_and(|m| !moving.contains(&m))
+    }
+
+    /// The modules not connected to the ground or a fixed module, with
+    /// `exclude` taken out of the structure.
+    pub fn unanchored(&self, exclude: &FxHashSet<ModuleId>) -> Vec<ModuleId> {
+        self.config.unanchored(
+            self.lattice,
+            self.ground,
+            &self.fixed,
+            exclude,
+            &|a, b| self.latched(a, b),
+        )
+    }
+
+    fn require_present(&self, id: ModuleId, step: usize) -> Result<Cell, InputError> {
+        if let Some(c) = self.config.cell_of(id) {
+            return Ok(c);
+        }
+        let msg = match self.left_at.get(&id) {
+            Some(k) => format!("module {id} is not in the scene (it left at step {k})"),
+            None => format!("unknown module id {id}"),
+        };
+        Err(InputError::new(msg).at_step(step).for_module(id))
+    }
+
+    /// Resolves a step's events against the scene. Input errors: references
+    /// to modules that are not there, a `from` cell that is not where the
+    /// module is, a move that is not a move of the lattice.
+    pub fn resolve(&self, step: usize, events: &Step) -> Result<StepPlan, InputError> {
+        let mut plan = StepPlan {
+            step,
+            ..Default::default()
+        };
+        let mut seen_motion: FxHashSet<ModuleId> = FxHashSet::default();
+        for ev in &events.events {
+            let id = ev.module();
+            let err = |msg: String| InputError::new(msg).at_step(step).for_module(id);
+            match ev {
+                Event::Rotate { .. } | Event::Slide { .. } | Event::Tunnel { .. } => {
+                    let here = self.require_present(id, step)?;
+                    let (from, pivot_id) = match ev {
+                        Event::Rotate { from, pivot, .. } => (*from, Some(*pivot)),
+                        Event::Slide { from, pivot, .. } => (*from, *pivot),
+                        Event::Tunnel { path, .. } => {
+                            let first = *path.first().ok_or_else(|| err("empty tunnel path".into()))?;
+                            (first, None)
+                        }
+                        _ => unreachable!(),
+                    };
+                    if from != here {
+                        return Err(err(format!(
+                            "impossible move: the module is at {here}, not at {from}"
+                        )));
+                    }
+                    if !seen_motion.insert(id) {
+                        plan.violations.push(
+                            Violation::new(
+                                ViolationKind::MultipleMoves,
+                                step,
+                                format!("module {id} is given more than one move in one time step"),
+                            )
+                            .modules([id]),
+                        );
+                        continue;
+                    }
+                    let pivot_cell = match pivot_id {
+                        Some(p) if p == id => {
+                            return Err(err("a module cannot be its own pivot".into()));
+                        }
+                        Some(p) => match self.config.cell_of(p) {
+                            Some(c) => Some(c),
+                            None if self.left_at.contains_key(&p) => {
+                                plan.violations.push(
+                                    Violation::new(
+                                        ViolationKind::PivotMissing,
+                                        step,
+                                        format!("module {id} rolls on pivot {p}, which is not in the scene"),
+                                    )
+                                    .modules([id, p]),
+                                );
+                                None
+                            }
+                            None => return Err(err(format!("unknown pivot module id {p}"))),
+                        },
+                        None => None,
+                    };
+                    let motion = match ev {
+                        Event::Rotate { to, route, .. } => Motion::Rotate {
+                            from,
+                            to: *to,
+                            pivot: pivot_cell.unwrap_or(from),
+                            route: *route,
+                        },
+                        Event::Slide { to, .. } => Motion::Slide {
+                            from,
+                            to: *to,
+                            pivot: pivot_cell,
+                        },
+                        Event::Tunnel { path, .. } => Motion::Tunnel { path: path.clone() },
+                        _ => unreachable!(),
+                    };
+                    for c in [motion.from(), motion.to()] {
+                        self.check_cell(c).map_err(err)?;
+                    }
+                    let pivot_resolved = pivot_id.is_none() || pivot_cell.is_some();
+                    let requirements = if pivot_resolved {
+                        self.lattice
+                            .move_requirements(&motion)
+                            .map_err(|e| err(format!("not a {} move: {e}", self.lattice.kind().name())))?
+                    } else {
+                        MoveRequirements::default()
+                    };
+                    plan.moving.insert(id);
+                    plan.moves.push(Move {
+                        module: id,
+                        pivot: pivot_id.filter(|_| pivot_cell.is_some()),
+                        motion,
+                        requirements,
+                        pivot_resolved,
+                    });
+                }
+                Event::Enter { cell, .. } => {
+                    if self.config.contains(id) {
+                        return Err(err(format!("module {id} enters but is already in the scene")));
+                    }
+                    self.check_cell(*cell).map_err(err)?;
+                    plan.enters.push((id, *cell));
+                }
+                Event::Leave { .. } => {
+                    self.require_present(id, step)?;
+                    plan.moving.insert(id);
+                    plan.leaves.push(id);
+                }
+                Event::Attach { other, .. } | Event::Detach { other, .. } => {
+                    self.require_present(id, step)?;
+                    self.require_present(*other, step)?;
+                    if matches!(ev, Event::Attach { .. }) {
+                        plan.attaches.push((id, *other));
+                    } else {
+                        plan.detaches.push((id, *other));
+                    }
+                }
+            }
+        }
+        Ok(plan)
+    }
+
+    /// Applies a step. Returns the occupancy clashes (two modules ending in
+    /// one cell); on a clash the later module stays where it was.
+    pub fn apply(&mut self, plan: &StepPlan) -> Vec<Violation> {
+        let mut clashes = Vec::new();
+        for m in &plan.moves {
+            self.config.remove(m.module);
+        }
+        let arrivals = plan
+            .moves
+            .iter()
+            .map(|m| (m.module, m.motion.to(), m.motion.from()))
+            .chain(plan.enters.iter().map(|&(id, c)| (id, c, c)));
+        for (id, to, from) in arrivals {
+            if let Err(other) = self.config.insert(id, to) {
+                clashes.push(
+                    Violation::new(
+                        ViolationKind::Occupancy,
+                        plan.step,
+                        format!("two modules in one cell: {id} and {other} both end the step at {to}"),
+                    )
+                    .modules([id, other])
+                    .cells([to]),
+                );
+                if from != to {
+                    let _ = self.config.insert(id, from);
+                }
+            }
+        }
+        for &(a, b) in &plan.attaches {
+            self.detached.remove(&pair(a, b));
+        }
+        for &(a, b) in &plan.detaches {
+            self.detached.insert(pair(a, b));
+        }
+        for &id in &plan.leaves {
+            self.config.remove(id);
+            self.left_at.insert(id, plan.step);
+            self.detached.retain(|&(a, b)| a != id && b != id);
+        }
+        clashes
+    }
+}

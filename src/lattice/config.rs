@@ -1,0 +1,176 @@
+//! A configuration: which module is in which cell, and the latch graph it
+//! induces on a lattice.
+
+use super::{Cell, Lattice};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Module identifier, as written in schedule files.
+pub type ModuleId = u32;
+
+/// The ground: a horizontal plane below layer `layer`. Modules in that layer
+/// rest on (and latch to) the ground; cells below it are solid ground.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Ground {
+    pub layer: i32,
+}
+
+impl Ground {
+    pub fn is_ground_cell(&self, lattice: &dyn Lattice, c: Cell) -> bool {
+        lattice.layer(c) < self.layer
+    }
+
+    pub fn touches(&self, lattice: &dyn Lattice, c: Cell) -> bool {
+        lattice.layer(c) == self.layer
+    }
+}
+
+/// Occupancy of lattice cells by modules, indexed both ways.
+#[derive(Clone, Debug, Default)]
+pub struct Configuration {
+    by_cell: FxHashMap<Cell, ModuleId>,
+    by_module: FxHashMap<ModuleId, Cell>,
+}
+
+impl Configuration {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn len(&self) -> usize {
+        self.by_module.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.by_module.is_empty()
+    }
+
+    /// Places `id` in `cell`. Returns the module already there, if any
+    /// (the configuration is left unchanged in that case).
+    pub fn insert(&mut self, id: ModuleId, cell: Cell) -> Result<(), ModuleId> {
+        if let Some(&other) = self.by_cell.get(&cell) {
+            return Err(other);
+        }
+        if let Some(old) = self.by_module.insert(id, cell) {
+            self.by_cell.remove(&old);
+        }
+        self.by_cell.insert(cell, id);
+        Ok(())
+    }
+
+    pub fn remove(&mut self, id: ModuleId) -> Option<Cell> {
+        let c = self.by_module.remove(&id)?;
+        self.by_cell.remove(&c);
+        Some(c)
+    }
+
+    pub fn at(&self, cell: Cell) -> Option<ModuleId> {
+        self.by_cell.get(&cell).copied()
+    }
+
+    pub fn cell_of(&self, id: ModuleId) -> Option<Cell> {
+        self.by_module.get(&id).copied()
+    }
+
+    pub fn contains(&self, id: ModuleId) -> bool {
+        self.by_module.contains_key(&id)
+    }
+
+    pub fn is_free(&self, cell: Cell) -> bool {
+        !self.by_cell.contains_key(&cell)
+    }
+
+    /// Modules and their cells, in ascending id order (deterministic).
+    pub fn modules(&self) -> Vec<(ModuleId, Cell)> {
+        let mut v: Vec<_> = self.by_module.iter().map(|(&m, &c)| (m, c)).collect();
+        v.sort_unstable();
+        v
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (ModuleId, Cell)> + '_ {
+        self.by_module.iter().map(|(&m, &c)| (m, c))
+    }
+
+    /// The modules of the configuration that are not connected, through
+    /// latched neighbours, to an anchor (a module touching the ground or a
+    /// fixed module). Modules in `exclude` are ignored (they are moving).
+    /// In a scene with neither ground nor fixed modules the structure must
+    /// form one component: everything outside the component of the lowest
+    /// id is returned.
+    pub fn unanchored(
+        &self,
+        lattice: &dyn Lattice,
+        ground: Option<Ground>,
+        fixed: &FxHashSet<ModuleId>,
+        exclude: &FxHashSet<ModuleId>,
+        latched: &dyn Fn(ModuleId, ModuleId) -> bool,
+    ) -> Vec<ModuleId> {
+        let mut seen: FxHashSet<ModuleId> = FxHashSet::default();
+        let mut stack: Vec<(ModuleId, Cell)> = Vec::new();
+        for (m, c) in self.iter() {
+            if exclude.contains(&m) {
+                continue;
+            }
+            let anchored =
+                fixed.contains(&m) || ground.is_some_and(|g| g.touches(lattice, c));
+            if anchored && seen.insert(m) {
+                stack.push((m, c));
+            }
+        }
+        if ground.is_none() && fixed.is_empty() {
+            if let Some((m, c)) = self
+                .modules()
+                .into_iter()
+                .find(|(m, _)| !exclude.contains(m))
+            {
+                seen.insert(m);
+                stack.push((m, c));
+            }
+        }
+        while let Some((m, c)) = stack.pop() {
+            for n in lattice.neighbours(c) {
+                if let Some(o) = self.at(n) {
+                    if !exclude.contains(&o) && !seen.contains(&o) && latched(m, o) {
+                        seen.insert(o);
+                        stack.push((o, n));
+                    }
+                }
+            }
+        }
+        let mut out: Vec<ModuleId> = self
+            .iter()
+            .map(|(m, _)| m)
+            .filter(|m| !exclude.contains(m) && !seen.contains(m))
+            .collect();
+        out.sort_unstable();
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::SquareLattice;
+
+    #[test]
+    fn two_modules_cannot_share_a_cell() {
+        let mut c = Configuration::new();
+        c.insert(1, Cell::xy(0, 0)).unwrap();
+        assert_eq!(c.insert(2, Cell::xy(0, 0)), Err(1));
+        assert_eq!(c.len(), 1);
+    }
+
+    #[test]
+    fn a_floating_module_is_unanchored() {
+        let l = SquareLattice;
+        let mut c = Configuration::new();
+        c.insert(1, Cell::xy(0, 1)).unwrap();
+        c.insert(2, Cell::xy(0, 2)).unwrap();
+        c.insert(3, Cell::xy(3, 3)).unwrap();
+        let none = FxHashSet::default();
+        let g = Some(Ground { layer: 1 });
+        assert_eq!(c.unanchored(&l, g, &none, &none, &|_, _| true), vec![3]);
+        // Removing the middle of a column disconnects its top.
+        let ex: FxHashSet<_> = [1].into_iter().collect();
+        assert_eq!(c.unanchored(&l, g, &none, &ex, &|_, _| true), vec![2, 3]);
+    }
+}

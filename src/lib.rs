@@ -1,0 +1,20 @@
+//! reconfcheck — certifies that a lattice modular robot's reconfiguration is
+//! physically feasible.
+//!
+//! Layers, each depending only on those above it in this list:
+//!
+//! * [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
+//! * [`schedule`] — the versioned schedule format shared by every seed;
+//! * [`certify`] — replays a schedule and runs every check on every step;
+//! * [`algorithms`] — generators that emit schedules (depend on `lattice`
+//!   and `schedule`, never on `certify`);
+//! * [`scenario`] — runnable cases that name a generator and its inputs.
+
+pub mod algorithms;
+pub mod certify;
+pub mod error;
+pub mod lattice;
+pub mod scenario;
+pub mod schedule;
+
+pub use error::InputError;

@@ -1,0 +1,190 @@
+//! The schedule: one versioned JSON format for every lattice and every seed.
+//!
+//! A schedule is an initial configuration followed by time steps; each step
+//! is a set of events executed concurrently. See `docs/schedule-format.md`
+//! for the full description with examples.
+
+pub mod units;
+
+use crate::error::InputError;
+use crate::lattice::config::{Ground, ModuleId};
+use crate::lattice::{Cell, LatticeKind, Route};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+pub use units::Length;
+
+/// The value of the `format` field of every schedule file.
+pub const FORMAT: &str = "reconfcheck-schedule";
+/// The schedule format version this build reads and writes.
+pub const VERSION: u32 = 1;
+
+/// A reconfiguration schedule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Schedule {
+    pub format: String,
+    pub version: u32,
+    pub lattice: LatticeKind,
+    /// Lattice spacing `d` (centre-to-centre distance of latched modules).
+    pub spacing: Length,
+    /// Path of the physical model (relative to the schedule file), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    /// The ground plane, if the scene has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ground: Option<Ground>,
+    /// The initial configuration, fixed (ground/sandbox) modules included.
+    pub modules: Vec<ModuleSpec>,
+    /// Cells where new modules may enter (sandbox or reserve outlets).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<Cell>,
+    /// Cells through which modules leave the scene.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sinks: Vec<Cell>,
+    /// Free-form provenance written by generators (algorithm, parameters).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub meta: BTreeMap<String, serde_json::Value>,
+    pub steps: Vec<Step>,
+}
+
+/// One module of the initial configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModuleSpec {
+    pub id: ModuleId,
+    pub cell: Cell,
+    /// Fixed modules (sandbox, anchored base) never move and anchor the
+    /// structure like the ground does.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub fixed: bool,
+}
+
+/// One time step: events executed concurrently.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Step {
+    pub events: Vec<Event>,
+}
+
+/// Something that happens to a module during a time step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Event {
+    /// FCC rolling rotation of `module` on `pivot` (SPEC §3).
+    Rotate {
+        module: ModuleId,
+        pivot: ModuleId,
+        from: Cell,
+        to: Cell,
+        route: Route,
+    },
+    /// Sliding move on the square or cubic lattice. `pivot`: the module held
+    /// (the wall beside `from`, or the corner of a diagonal move); absent for
+    /// a slide along the ground.
+    Slide {
+        module: ModuleId,
+        from: Cell,
+        to: Cell,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pivot: Option<ModuleId>,
+    },
+    /// Seed 004 k-TUNNEL of a meta-module along `path` (start cell first).
+    Tunnel { module: ModuleId, path: Vec<Cell> },
+    /// A new module enters the scene at `cell` (from a sandbox or reserve).
+    Enter { module: ModuleId, cell: Cell },
+    /// `module` leaves the scene through the sink cell it is in at the end
+    /// of this step (it may arrive there by a move in the same step).
+    Leave { module: ModuleId },
+    /// Latch the connectors between two neighbouring modules.
+    Attach { module: ModuleId, other: ModuleId },
+    /// Release the connectors between two neighbouring modules.
+    Detach { module: ModuleId, other: ModuleId },
+}
+
+impl Event {
+    /// The module the event is about (the first one for latch events).
+    pub fn module(&self) -> ModuleId {
+        match self {
+            Event::Rotate { module, .. }
+            | Event::Slide { module, .. }
+            | Event::Tunnel { module, .. }
+            | Event::Enter { module, .. }
+            | Event::Leave { module }
+            | Event::Attach { module, .. }
+            | Event::Detach { module, .. } => *module,
+        }
+    }
+
+    /// Whether the event displaces its module between cells.
+    pub fn is_motion(&self) -> bool {
+        matches!(
+            self,
+            Event::Rotate { .. } | Event::Slide { .. } | Event::Tunnel { .. }
+        )
+    }
+}
+
+impl Schedule {
+    /// An empty schedule on `lattice` with unit spacing.
+    pub fn new(lattice: LatticeKind, spacing: Length) -> Self {
+        Schedule {
+            format: FORMAT.to_string(),
+            version: VERSION,
+            lattice,
+            spacing,
+            model: None,
+            ground: None,
+            modules: Vec::new(),
+            sources: Vec::new(),
+            sinks: Vec::new(),
+            meta: BTreeMap::new(),
+            steps: Vec::new(),
+        }
+    }
+
+    /// Number of motion events over all steps.
+    pub fn move_count(&self) -> usize {
+        self.steps
+            .iter()
+            .map(|s| s.events.iter().filter(|e| e.is_motion()).count())
+            .sum()
+    }
+
+    /// Parses a schedule from JSON text; `origin` names it in errors.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Schedule, InputError> {
+        let schedule: Schedule = serde_json::from_str(text).map_err(|e| {
+            InputError::new(format!("not a valid schedule: {e}")).in_file(origin)
+        })?;
+        schedule.check_header().map_err(|e| e.in_file(origin))?;
+        Ok(schedule)
+    }
+
+    /// Reads and parses a schedule file.
+    pub fn load(path: &Path) -> Result<Schedule, InputError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| InputError::new(format!("cannot read: {e}")).in_file(path))?;
+        Schedule::from_json(&text, path)
+    }
+
+    /// Writes the schedule as JSON (compact: schedules get large).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("schedules serialise")
+    }
+
+    fn check_header(&self) -> Result<(), InputError> {
+        if self.format != FORMAT {
+            return Err(InputError::new(format!(
+                "format is '{}', expected '{FORMAT}'",
+                self.format
+            )));
+        }
+        if self.version != VERSION {
+            return Err(InputError::new(format!(
+                "unsupported schedule version {} (this build reads version {VERSION})",
+                self.version
+            )));
+        }
+        Ok(())
+    }
+}
