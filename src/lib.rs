@@ -14,6 +14,7 @@ pub mod algorithms;
 pub mod certify;
 pub mod error;
 pub mod lattice;
+pub mod render;
 pub mod scenario;
 pub mod schedule;
 

@@ -1,0 +1,90 @@
+//! Pictures: plots and drawings, written as PNG (or SVG).
+//!
+//! Charts are drawn with `plotters` into SVG, then rasterised by `resvg`
+//! with the DejaVu Sans font shipped in `assets/fonts` (free licence) and
+//! compiled in, so rendering needs no system fonts or C libraries on a
+//! fresh machine. Draw with [`SvgCanvas`] and finish with [`save`].
+
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+/// The plotters backend charts draw on: an in-memory SVG document.
+pub type SvgCanvas<'a> = plotters::backend::SVGBackend<'a>;
+
+/// Writes an SVG document to `path`: as SVG if the extension is `.svg`,
+/// otherwise rasterised to PNG at the document's own size (× `scale`).
+pub fn save(svg: &str, path: &Path, scale: f32) -> Result<(), String> {
+    let is_svg = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    if is_svg {
+        return std::fs::write(path, svg).map_err(|e| format!("{}: {e}", path.display()));
+    }
+    let png = rasterise(svg, scale)?;
+    std::fs::write(path, png).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Rasterises an SVG document to PNG bytes.
+pub fn rasterise(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
+    let opt = usvg_options();
+    let tree = resvg::usvg::Tree::from_str(svg, opt).map_err(|e| format!("bad SVG: {e}"))?;
+    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty picture")?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or("picture too large")?;
+    pixmap.fill(resvg::tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::from_scale(scale, scale),
+        &mut pixmap.as_mut(),
+    );
+    pixmap.encode_png().map_err(|e| format!("PNG encoding failed: {e}"))
+}
+
+fn usvg_options() -> &'static resvg::usvg::Options<'static> {
+    static OPT: OnceLock<resvg::usvg::Options<'static>> = OnceLock::new();
+    OPT.get_or_init(|| {
+        let mut db = resvg::usvg::fontdb::Database::new();
+        db.load_font_data(FONT.to_vec());
+        db.set_sans_serif_family("DejaVu Sans");
+        db.set_serif_family("DejaVu Sans");
+        db.set_monospace_family("DejaVu Sans");
+        let mut opt = resvg::usvg::Options {
+            font_family: "DejaVu Sans".into(),
+            ..Default::default()
+        };
+        opt.fontdb = Arc::new(db);
+        opt
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plotters::prelude::*;
+
+    #[test]
+    fn a_chart_with_text_renders_to_png() {
+        let mut svg = String::new();
+        {
+            let root = SvgCanvas::with_string(&mut svg, (320, 240)).into_drawing_area();
+            root.fill(&WHITE).unwrap();
+            let mut chart = ChartBuilder::on(&root)
+                .caption("a caption", ("sans-serif", 20))
+                .x_label_area_size(30)
+                .y_label_area_size(30)
+                .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+                .unwrap();
+            chart.configure_mesh().draw().unwrap();
+            chart
+                .draw_series(LineSeries::new([(0.0, 0.0), (1.0, 1.0)], &RED))
+                .unwrap();
+            root.present().unwrap();
+        }
+        assert!(svg.contains("a caption"));
+        let png = rasterise(&svg, 1.0).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+        // Text was drawn: a picture with the caption differs from one without.
+        let blank = rasterise(&svg.replace("a caption", ""), 1.0).unwrap();
+        assert_ne!(png, blank);
+    }
+}
