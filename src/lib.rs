@@ -5,6 +5,7 @@
 //!
 //! * [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
 //! * [`schedule`] — the versioned schedule format shared by every seed;
+//! * [`geometry`] — module bodies and continuous sweeps;
 //! * [`certify`] — replays a schedule and runs every check on every step;
 //! * [`algorithms`] — generators that emit schedules (depend on `lattice`
 //!   and `schedule`, never on `certify`);
@@ -13,6 +14,7 @@
 pub mod algorithms;
 pub mod certify;
 pub mod error;
+pub mod geometry;
 pub mod lattice;
 pub mod render;
 pub mod scenario;

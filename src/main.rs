@@ -35,6 +35,15 @@ struct ReportArgs {
     /// Never show a progress bar.
     #[arg(long)]
     no_progress: bool,
+    /// Force exact sweeps everywhere (no compiled motion-rule tables).
+    #[arg(long)]
+    exact: bool,
+    /// Collision tolerance, in units of the lattice spacing d.
+    #[arg(long, default_value_t = reconfcheck::geometry::EPSILON)]
+    epsilon: f64,
+    /// Run the lattice checks only (occupancy, pivots, connectivity).
+    #[arg(long)]
+    lattice_only: bool,
 }
 
 #[derive(Subcommand)]
@@ -137,6 +146,9 @@ fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<
     let opts = Options {
         name: origin.display().to_string(),
         progress: !args.no_progress && std::io::stderr().is_terminal(),
+        exact: args.exact,
+        epsilon: args.epsilon,
+        lattice_only: args.lattice_only,
     };
     let report: Report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
     let json = report.to_json();

@@ -4,10 +4,12 @@
 //! Checks implement [`StepCheck`]; the lattice checks always run, geometric
 //! and mechanical checks join them where the lattice has a model for them.
 
+pub mod collision_check;
 pub mod lattice_check;
 pub mod report;
 pub mod world;
 
+pub use collision_check::CollisionCheck;
 pub use lattice_check::LatticeCheck;
 pub use report::{Report, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
@@ -23,6 +25,12 @@ pub struct Options {
     pub name: String,
     /// Show a progress bar on standard error for long schedules.
     pub progress: bool,
+    /// Force exact sweeps everywhere (no compiled rule tables).
+    pub exact: bool,
+    /// Collision tolerance in units of d.
+    pub epsilon: f64,
+    /// Run the lattice checks only (no geometry, no mechanics).
+    pub lattice_only: bool,
 }
 
 impl Default for Options {
@@ -30,6 +38,9 @@ impl Default for Options {
         Options {
             name: "schedule".into(),
             progress: false,
+            exact: false,
+            epsilon: crate::geometry::EPSILON,
+            lattice_only: false,
         }
     }
 }
@@ -60,9 +71,28 @@ pub trait StepCheck: Send + Sync {
     }
 }
 
-/// Certifies `schedule` with the lattice checks only.
+/// The checks that apply to a schedule: the lattice checks always, the
+/// collision check where the lattice has a body model.
+pub fn checks_for(schedule: &Schedule, opts: &Options) -> Result<Vec<Box<dyn StepCheck>>, InputError> {
+    let mut checks: Vec<Box<dyn StepCheck>> = vec![Box::new(LatticeCheck)];
+    if opts.lattice_only {
+        return Ok(checks);
+    }
+    if let Some(model) = crate::geometry::sweep_model(schedule.lattice) {
+        checks.push(Box::new(CollisionCheck {
+            model,
+            epsilon: opts.epsilon,
+            exact: opts.exact,
+        }));
+    }
+    Ok(checks)
+}
+
+/// Certifies `schedule` with every check that applies to it.
 pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError> {
-    certify_with(schedule, opts, &[&LatticeCheck])
+    let checks = checks_for(schedule, opts)?;
+    let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
+    certify_with(schedule, opts, &refs)
 }
 
 /// Certifies `schedule` with the given checks. Input errors (not a schedule

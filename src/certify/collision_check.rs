@@ -1,0 +1,72 @@
+//! True collision check (SPEC §4.3): each step's sweeps, through the
+//! lattice's [`SweepModel`].
+
+use super::report::{Violation, ViolationKind};
+use super::{StepCheck, StepContext, StepOutcome};
+use crate::geometry::{Contact, ContactKind, SweepInput, SweepModel};
+
+/// Runs a sweep model on every step.
+pub struct CollisionCheck {
+    pub model: &'static dyn SweepModel,
+    pub epsilon: f64,
+    pub exact: bool,
+}
+
+impl StepCheck for CollisionCheck {
+    fn name(&self) -> &'static str {
+        "collision"
+    }
+
+    fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome) {
+        let moves: Vec<_> = ctx
+            .plan
+            .moves
+            .iter()
+            .filter(|m| m.pivot_resolved)
+            .map(|m| (m.module, m.pivot, m.motion.clone()))
+            .collect();
+        if moves.is_empty() {
+            return;
+        }
+        let input = SweepInput {
+            lattice: ctx.world.lattice,
+            config: &ctx.world.config,
+            moves: &moves,
+            moving: &ctx.plan.moving,
+            epsilon: self.epsilon,
+            exact: self.exact,
+        };
+        let mut deepest: f64 = 0.0;
+        for c in self.model.check_step(&input) {
+            deepest = deepest.max(c.depth);
+            let v = contact_violation(&c, ctx.plan.step);
+            match c.kind {
+                ContactKind::Collision => out.violations.push(v),
+                ContactKind::SlidingContact => out.warnings.push(v),
+            }
+        }
+        if deepest > 0.0 {
+            out.metrics.insert("max_penetration".into(), deepest);
+        }
+    }
+}
+
+fn contact_violation(c: &Contact, step: usize) -> Violation {
+    let (kind, what) = match c.kind {
+        ContactKind::Collision => (ViolationKind::Collision, "penetrates"),
+        ContactKind::SlidingContact => (ViolationKind::SlidingContact, "slides in contact with"),
+    };
+    Violation::new(
+        kind,
+        step,
+        format!(
+            "module {} {what} module {} at s = {:.4} (depth {:.3e} d)",
+            c.mover, c.other, c.s, c.depth
+        ),
+    )
+    .modules([c.mover, c.other])
+    .detail("s", c.s)
+    .detail("depth", c.depth)
+    .detail("witness_mover", c.witness_mover.to_array())
+    .detail("witness_other", c.witness_other.to_array())
+}

@@ -1,0 +1,70 @@
+//! Geometry: module bodies and the continuous sweeps of their moves.
+//!
+//! Each lattice with a body model provides a [`SweepModel`]; certification
+//! asks [`sweep_model`] for the one of the schedule's lattice and turns the
+//! contacts it reports into violations and warnings.
+
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
+use glam::DVec3;
+use rustc_hash::FxHashSet;
+use serde::{Deserialize, Serialize};
+
+/// Default certification tolerance, in units of the lattice spacing d.
+pub const EPSILON: f64 = 1e-6;
+
+/// One step's moves, as the sweep model sees them.
+pub struct SweepInput<'a> {
+    pub lattice: &'a dyn Lattice,
+    /// Occupancy at the start of the step (movers at their start cells).
+    pub config: &'a Configuration,
+    /// The moves of the step: mover, its pivot (if any) and its motion.
+    pub moves: &'a [(ModuleId, Option<ModuleId>, Motion)],
+    /// Modules that do not stay put during the step.
+    pub moving: &'a FxHashSet<ModuleId>,
+    /// Tolerance ε in units of d: penetration deeper than ε is a collision,
+    /// contact within ±ε with a module other than the pivot is sliding contact.
+    pub epsilon: f64,
+    /// Force the exact sweep (no compiled rule tables).
+    pub exact: bool,
+}
+
+/// What a sweep found between a mover and another module.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Contact {
+    pub kind: ContactKind,
+    /// Sweep parameter s ∈ [0, 1] of the deepest point found.
+    pub s: f64,
+    /// The mover.
+    pub mover: ModuleId,
+    /// The other module (static, or another mover).
+    pub other: ModuleId,
+    /// Penetration depth in units of d (0 for sliding contact).
+    pub depth: f64,
+    /// Witness points on each body, world frame, units of d.
+    pub witness_mover: DVec3,
+    pub witness_other: DVec3,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactKind {
+    /// Signed distance below −ε: the bodies interpenetrate.
+    Collision,
+    /// Signed distance within ±ε of a module that is not the pivot.
+    SlidingContact,
+}
+
+/// Continuous collision checking of one lattice's module bodies.
+pub trait SweepModel: Send + Sync {
+    fn name(&self) -> &'static str;
+    /// All collisions and sliding contacts of one step's concurrent moves.
+    fn check_step(&self, input: &SweepInput<'_>) -> Vec<Contact>;
+}
+
+/// The sweep model of a lattice, if this build has a body model for it.
+pub fn sweep_model(kind: LatticeKind) -> Option<&'static dyn SweepModel> {
+    match kind {
+        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+    }
+}
