@@ -68,3 +68,26 @@ pub fn sweep_model(kind: LatticeKind) -> Option<&'static dyn SweepModel> {
         LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
     }
 }
+
+/// Motion rules derived from the body geometry: which cells a move needs
+/// empty. Generators plan with these; certification checks sweeps exactly.
+pub trait MotionRules: Send + Sync {
+    /// The cells (absolute lattice cells) whose occupant the move's sweep
+    /// would penetrate: every one of them must be empty (or hold a module
+    /// that is itself leaving) for the move to be collision-free against
+    /// static modules. The pivot, the start and the target are not listed.
+    fn blocking_cells(&self, motion: &Motion) -> Vec<crate::lattice::Cell>;
+
+    /// Whether `motion` is free of collisions with static modules, given
+    /// which cells are occupied at the start of the step.
+    fn allows(&self, motion: &Motion, occupied: &dyn Fn(crate::lattice::Cell) -> bool) -> bool {
+        self.blocking_cells(motion).into_iter().all(|c| !occupied(c))
+    }
+}
+
+/// The motion rules of a lattice, if this build derives them.
+pub fn motion_rules(kind: LatticeKind) -> Option<&'static dyn MotionRules> {
+    match kind {
+        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+    }
+}
