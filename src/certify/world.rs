@@ -20,6 +20,9 @@ pub struct World {
     detached: FxHashSet<(ModuleId, ModuleId)>,
     /// Every id that was ever in the scene, and the step it left at.
     left_at: FxHashMap<ModuleId, usize>,
+    /// Whether the configuration is known to be anchored as a whole, which
+    /// lets connectivity be checked locally around the movers.
+    anchored: bool,
 }
 
 fn pair(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
@@ -70,6 +73,7 @@ impl World {
             sinks: s.sinks.iter().copied().collect(),
             detached: FxHashSet::default(),
             left_at: FxHashMap::default(),
+            anchored: false,
         };
         for m in &s.modules {
             let err = |msg: String| InputError::new(msg).at_step(0).for_module(m.id);
@@ -131,6 +135,14 @@ impl World {
             .unanchored(self.lattice, self.ground, &self.fixed, exclude, &|a, b| {
                 self.latched(a, b)
             })
+    }
+
+    /// Records whether every module is known to be anchored now. True only
+    /// when established: by a full check, or by a step with no violations
+    /// and no released latches (its static part was anchored and each mover
+    /// ended latched to a static pivot or support).
+    pub fn set_anchored(&mut self, anchored: bool) {
+        self.anchored = anchored;
     }
 
     fn require_present(&self, id: ModuleId, step: usize) -> Result<Cell, InputError> {
