@@ -4,6 +4,11 @@
 //! asks [`sweep_model`] for the one of the schedule's lattice and turns the
 //! contacts it reports into violations and warnings.
 
+pub mod catom;
+pub mod rolling;
+pub mod rules;
+pub mod sweep;
+
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
 use glam::DVec3;
@@ -81,13 +86,16 @@ pub trait MotionRules: Send + Sync {
     /// Whether `motion` is free of collisions with static modules, given
     /// which cells are occupied at the start of the step.
     fn allows(&self, motion: &Motion, occupied: &dyn Fn(crate::lattice::Cell) -> bool) -> bool {
-        self.blocking_cells(motion).into_iter().all(|c| !occupied(c))
+        self.blocking_cells(motion)
+            .into_iter()
+            .all(|c| !occupied(c))
     }
 }
 
 /// The motion rules of a lattice, if this build derives them.
 pub fn motion_rules(kind: LatticeKind) -> Option<&'static dyn MotionRules> {
     match kind {
-        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+        LatticeKind::Fcc => Some(&rules::FccRules),
+        LatticeKind::Square | LatticeKind::Cubic => None,
     }
 }
