@@ -72,6 +72,21 @@ fn outcome_contact(o: PairOutcome, mover: ModuleId, other: ModuleId) -> Option<C
     }
 }
 
+/// Whether two rotations executed in the same step keep clear of each
+/// other (exact sweep where their swept balls overlap; sliding contact
+/// counts as not clear). `true` for motions that are not FCC rotations.
+pub fn rotations_clear(a: &Motion, b: &Motion) -> bool {
+    let l = crate::lattice::FccLattice;
+    let (Some(ra), Some(rb)) = (Roll::of_motion(&l, a), Roll::of_motion(&l, b)) else {
+        return true;
+    };
+    let ((ca, rad_a), (cb, rad_b)) = (swept_ball(ra.link), swept_ball(rb.link));
+    if (ca + ra.pivot - cb - rb.pivot).length() > rad_a + rad_b {
+        return true;
+    }
+    sweep_pair(&ra, &Path::Rolling(rb), EPSILON).outcome == PairOutcome::Clear
+}
+
 impl FccSweep {
     fn statics(
         &self,

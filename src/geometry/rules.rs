@@ -237,6 +237,25 @@ pub fn table() -> &'static RuleTable {
     TABLE.get_or_init(|| RuleTable::derive(EPSILON))
 }
 
+/// Cells whose occupant the move's sweep penetrates *or touches* (blocking
+/// and sliding cells, the target excluded): what a planner that wants
+/// neither collisions nor sliding contact keeps empty. Empty for a motion
+/// that is not an FCC rotation.
+pub fn touched_cells(motion: &Motion) -> Vec<Cell> {
+    let (Some(link), Motion::Rotate { pivot, to, .. }) =
+        (Link::of_motion(&FccLattice, motion), motion)
+    else {
+        return Vec::new();
+    };
+    table()
+        .get(link)
+        .entries
+        .iter()
+        .map(|e| e.offset.from(*pivot))
+        .filter(|c| c != to)
+        .collect()
+}
+
 /// [`MotionRules`] of the FCC lattice from the derived table.
 pub struct FccRules;
 
