@@ -32,6 +32,30 @@ pub struct WalkParams {
     pub activity: f64,
     #[serde(default)]
     pub seed: u64,
+    /// Keep only moves the body geometry allows (no collision, no sliding
+    /// contact): the default. `false` takes every lattice-valid move.
+    #[serde(default = "default_geometric")]
+    pub geometric: bool,
+}
+
+fn default_geometric() -> bool {
+    true
+}
+
+/// The geometric move filter: a candidate rotation is taken when none of
+/// the cells its sweep penetrates or touches (derived motion rules,
+/// [`crate::geometry::rules::touched_cells`]) is occupied at the start of
+/// the step or claimed as a target by a move already chosen, and when its
+/// sweep keeps clear of every chosen move's sweep (exact mover–mover check).
+/// Walks generated with it certify without collisions or sliding contacts.
+pub fn collision_free(config: &Configuration, m: &Motion, chosen: &[Motion]) -> bool {
+    let claimed = |c: Cell| chosen.iter().any(|x| x.to() == c);
+    crate::geometry::rules::touched_cells(m)
+        .into_iter()
+        .all(|c| config.is_free(c) && !claimed(c))
+        && chosen
+            .iter()
+            .all(|x| crate::geometry::fcc_sweep::rotations_clear(m, x))
 }
 
 fn default_activity() -> f64 {
@@ -67,7 +91,11 @@ impl Generator for RandomWalk {
                 p.walkers, p.width, p.depth
             )));
         }
-        Ok(walk(&p, &|_, _, _| true))
+        if p.geometric {
+            Ok(walk(&p, &collision_free))
+        } else {
+            Ok(walk(&p, &|_, _, _| true))
+        }
     }
 }
 

@@ -101,6 +101,18 @@ impl Catom {
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
+    /// Support point of the body at rest in the unit direction `u` (a
+    /// vertex of `Q` pushed out by `L` along `u`).
+    pub fn support_point(&self, u: DVec3) -> DVec3 {
+        let v = self
+            .vertices
+            .iter()
+            .copied()
+            .max_by(|a, b| a.dot(u).total_cmp(&b.dot(u)))
+            .expect("24 vertices");
+        v + L * u
+    }
+
     /// Support function `h_B(u) = h_Q(u) + L|u|` of the body at rest.
     pub fn support(&self, u: DVec3) -> f64 {
         self.support_q(u) + L * u.length()
@@ -119,12 +131,18 @@ impl Catom {
     /// Signed distance between two catoms at the given poses, if it is below
     /// `prediction` (a larger distance returns `None`).
     pub fn gap(&self, a: &Pose, b: &Pose, prediction: f64) -> Option<Gap> {
-        let c = query::contact(a, &self.shape, b, &self.shape, prediction)
-            .expect("parry supports round convex polyhedra")?;
+        // The rounded bodies' signed distance is the inner polyhedra's minus
+        // 2L, with the witnesses pushed out by L along the normal. Querying
+        // the inner polyhedra (apart by up to 2L even when the bodies
+        // penetrate) keeps GJK away from touching configurations, where
+        // parry's rounded-shape path can return a spurious 0.
+        let inner = &self.shape.inner_shape;
+        let c = query::contact(a, inner, b, inner, prediction + 2.0 * L)
+            .expect("parry supports convex polyhedra")?;
         Some(Gap {
-            dist: c.dist,
-            p1: c.point1,
-            p2: c.point2,
+            dist: c.dist - 2.0 * L,
+            p1: c.point1 + L * c.normal1,
+            p2: c.point2 + L * c.normal2,
             normal: c.normal1,
         })
     }

@@ -5,6 +5,7 @@
 //! contacts it reports into violations and warnings.
 
 pub mod catom;
+pub mod fcc_sweep;
 pub mod rolling;
 pub mod rules;
 pub mod sweep;
@@ -70,7 +71,8 @@ pub trait SweepModel: Send + Sync {
 /// The sweep model of a lattice, if this build has a body model for it.
 pub fn sweep_model(kind: LatticeKind) -> Option<&'static dyn SweepModel> {
     match kind {
-        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+        LatticeKind::Fcc => Some(&fcc_sweep::FccSweep),
+        LatticeKind::Square | LatticeKind::Cubic => None,
     }
 }
 

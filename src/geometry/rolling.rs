@@ -234,6 +234,30 @@ impl Roll {
             + vc / (2.0 * n as f64)
     }
 
+    /// A ball containing the mover's body along the whole sweep: (centre
+    /// relative to the pivot, radius). Sampled centres plus the Lipschitz
+    /// slack of the sampling plus the body's circumradius.
+    pub fn swept_ball(&self) -> (DVec3, f64) {
+        let n = 256;
+        let body = catom();
+        let (rq, rb) = (body.radius_q(), body.radius());
+        let vc = 4.0 * self.phi1.max(self.phi2) * (rq * rq + rb * rb).sqrt();
+        let pts: Vec<DVec3> = (0..=n)
+            .map(|i| self.centre(i as f64 / n as f64) - self.pivot)
+            .collect();
+        let lo = pts
+            .iter()
+            .copied()
+            .fold(DVec3::splat(f64::INFINITY), DVec3::min);
+        let hi = pts
+            .iter()
+            .copied()
+            .fold(DVec3::splat(f64::NEG_INFINITY), DVec3::max);
+        let mid = 0.5 * (lo + hi);
+        let r = pts.iter().map(|p| (*p - mid).length()).fold(0.0, f64::max);
+        (mid, r + vc / (2.0 * n as f64) + rb)
+    }
+
     /// Unit direction pivot → target.
     pub fn target_normal(&self) -> DVec3 {
         self.n_t

@@ -19,7 +19,6 @@ use super::sweep::{PairOutcome, Path, Sample, sweep_pair};
 use super::{ContactKind, EPSILON, MotionRules};
 use crate::lattice::{Cell, FccLattice, Lattice, Motion};
 use glam::DVec3;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
@@ -147,62 +146,77 @@ impl RuleTable {
     /// cell within reach, with tolerance `eps`.
     pub fn derive(eps: f64) -> RuleTable {
         let offsets = offsets_within_reach();
-        let links: Vec<LinkRules> = links()
-            .into_par_iter()
-            .map(|link| {
-                let roll = Roll::new(DVec3::ZERO, link);
-                let from = Offset::between(
-                    Cell::new(0, 0, 0),
-                    FccLattice.neighbour(Cell::new(0, 0, 0), link.from as usize),
-                );
-                let mut halves: Vec<(Offset, [Option<Sample>; 2])> = Vec::new();
-                let entries = offsets
-                    .iter()
-                    .filter(|o| **o != from)
-                    .filter_map(|&offset| {
-                        let sw = sweep_pair(&roll, &Path::Static(offset.vector()), eps);
-                        let (kind, x) = match sw.outcome {
-                            PairOutcome::Clear => return None,
-                            PairOutcome::Sliding(x) => (ContactKind::SlidingContact, x),
-                            PairOutcome::Collision(x) => (ContactKind::Collision, x),
-                        };
-                        if kind == ContactKind::SlidingContact {
-                            halves.push((offset, sw.sliding));
-                        }
-                        Some(RuleEntry {
-                            offset,
-                            kind,
-                            s: x.s,
-                            depth: if kind == ContactKind::Collision {
-                                -x.gap.dist
-                            } else {
-                                0.0
-                            },
-                            witness_mover: x.gap.p1,
-                            witness_other: x.gap.p2,
-                            normal: x.gap.normal,
-                        })
+        let all = links();
+        // Plain scoped threads, not rayon: the table is built inside a
+        // OnceLock that rayon workers may be blocked on (a rayon pool
+        // would deadlock waiting for them).
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let chunk = all.len().div_ceil(threads);
+        let derive_link = |link: Link| {
+            let roll = Roll::new(DVec3::ZERO, link);
+            let from = Offset::between(
+                Cell::new(0, 0, 0),
+                FccLattice.neighbour(Cell::new(0, 0, 0), link.from as usize),
+            );
+            let mut halves: Vec<(Offset, [Option<Sample>; 2])> = Vec::new();
+            let entries = offsets
+                .iter()
+                .filter(|o| **o != from)
+                .filter_map(|&offset| {
+                    let sw = sweep_pair(&roll, &Path::Static(offset.vector()), eps);
+                    let (kind, x) = match sw.outcome {
+                        PairOutcome::Clear => return None,
+                        PairOutcome::Sliding(x) => (ContactKind::SlidingContact, x),
+                        PairOutcome::Collision(x) => (ContactKind::Collision, x),
+                    };
+                    if kind == ContactKind::SlidingContact {
+                        halves.push((offset, sw.sliding));
+                    }
+                    Some(RuleEntry {
+                        offset,
+                        kind,
+                        s: x.s,
+                        depth: if kind == ContactKind::Collision {
+                            -x.gap.dist
+                        } else {
+                            0.0
+                        },
+                        witness_mover: x.gap.p1,
+                        witness_other: x.gap.p2,
+                        normal: x.gap.normal,
                     })
-                    .collect::<Vec<_>>();
-                let mut pinches = Vec::new();
-                for (i, (a, ha)) in halves.iter().enumerate() {
-                    for (b, hb) in &halves[i + 1..] {
-                        let opposite = ha.iter().zip(hb).any(|(x, y)| match (x, y) {
-                            (Some(x), Some(y)) => x.gap.normal.dot(y.gap.normal) < -PINCH_COSINE,
-                            _ => false,
-                        });
-                        if opposite {
-                            pinches.push((*a, *b));
-                        }
+                })
+                .collect::<Vec<_>>();
+            let mut pinches = Vec::new();
+            for (i, (a, ha)) in halves.iter().enumerate() {
+                for (b, hb) in &halves[i + 1..] {
+                    let opposite = ha.iter().zip(hb).any(|(x, y)| match (x, y) {
+                        (Some(x), Some(y)) => x.gap.normal.dot(y.gap.normal) < -PINCH_COSINE,
+                        _ => false,
+                    });
+                    if opposite {
+                        pinches.push((*a, *b));
                     }
                 }
-                LinkRules {
-                    link,
-                    entries,
-                    pinches,
-                }
-            })
-            .collect();
+            }
+            LinkRules {
+                link,
+                entries,
+                pinches,
+            }
+        };
+        let links: Vec<LinkRules> = std::thread::scope(|scope| {
+            let handles: Vec<_> = all
+                .chunks(chunk)
+                .map(|part| {
+                    scope.spawn(|| part.iter().map(|l| derive_link(*l)).collect::<Vec<_>>())
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().expect("rule derivation does not panic"))
+                .collect()
+        });
         let mut index = [[[u8::MAX; 2]; 12]; 12];
         for (i, r) in links.iter().enumerate() {
             index[r.link.from as usize][r.link.to as usize][r.link.route as usize] = i as u8;
@@ -221,6 +235,25 @@ impl RuleTable {
 pub fn table() -> &'static RuleTable {
     static TABLE: OnceLock<RuleTable> = OnceLock::new();
     TABLE.get_or_init(|| RuleTable::derive(EPSILON))
+}
+
+/// Cells whose occupant the move's sweep penetrates *or touches* (blocking
+/// and sliding cells, the target excluded): what a planner that wants
+/// neither collisions nor sliding contact keeps empty. Empty for a motion
+/// that is not an FCC rotation.
+pub fn touched_cells(motion: &Motion) -> Vec<Cell> {
+    let (Some(link), Motion::Rotate { pivot, to, .. }) =
+        (Link::of_motion(&FccLattice, motion), motion)
+    else {
+        return Vec::new();
+    };
+    table()
+        .get(link)
+        .entries
+        .iter()
+        .map(|e| e.offset.from(*pivot))
+        .filter(|c| c != to)
+        .collect()
 }
 
 /// [`MotionRules`] of the FCC lattice from the derived table.
