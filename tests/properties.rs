@@ -27,6 +27,7 @@ fn params() -> impl Strategy<Value = WalkParams> {
                 steps,
                 activity,
                 seed,
+                geometric: false,
             },
         )
 }
