@@ -70,7 +70,7 @@ fn certification(c: &mut Criterion) {
         width: 80,
         depth: 80,
         walkers: 600,
-        steps: 260,
+        steps: 300,
         activity: 0.8,
         seed: 1,
         geometric: true,
