@@ -555,4 +555,37 @@ mod tests {
                 .any(|e| e["kind"] == "collision")
         );
     }
+
+    /// The lattice's symmetry maps links of one class onto each other, so
+    /// an independent derivation per link must give the same counts within
+    /// each class: hexagonal 60°, octagonal 60° and octagonal 90°.
+    #[test]
+    fn derivation_respects_the_lattice_symmetry() {
+        let o = Cell::new(0, 0, 0);
+        let mut classes: std::collections::BTreeMap<(Route, bool), Vec<(usize, usize, usize)>> =
+            Default::default();
+        for r in &table().links {
+            let target = Offset::between(o, FccLattice.neighbour(o, r.link.to as usize));
+            let blocking = r.blocking().filter(|b| *b != target).count();
+            let sliding = r
+                .entries
+                .iter()
+                .filter(|e| e.kind == ContactKind::SlidingContact)
+                .count();
+            classes
+                .entry((r.link.route, r.link.is_right_angle()))
+                .or_default()
+                .push((blocking, sliding, r.pinches.len()));
+        }
+        let expect = [
+            ((Route::Hexagonal, false), 48, (6, 3, 2)),
+            ((Route::Octagonal, false), 48, (8, 0, 0)),
+            ((Route::Octagonal, true), 24, (9, 0, 0)),
+        ];
+        for (class, n, counts) in expect {
+            let v = &classes[&class];
+            assert_eq!(v.len(), n, "{class:?}");
+            assert!(v.iter().all(|c| *c == counts), "{class:?}: {v:?}");
+        }
+    }
 }
