@@ -76,6 +76,21 @@ enum Command {
     },
     /// List the generators (algorithms) scenarios can name.
     Algorithms,
+    /// Derive the FCC motion rules (cells blocking each of the 120 rotation
+    /// links) from the catom geometry and print them as a table.
+    Rules {
+        /// Also write the rules as JSON to this file.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+    },
+    /// Draw the catom geometry: the body, one sweep or one collision
+    /// (PNG, or SVG if the file name ends in .svg).
+    Render {
+        #[arg(value_enum)]
+        picture: reconfcheck::geometry::picture::Picture,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 enum Failure {
@@ -136,6 +151,20 @@ fn run(cmd: Command) -> Result<u8, Failure> {
                 write(out, &s.to_json())?;
             }
             certify_and_report(&s, &path, &report)
+        }
+        Command::Rules { json } => {
+            let t = reconfcheck::geometry::rules::table();
+            print!("{}", t.to_text());
+            if let Some(p) = json {
+                write(&p, &t.to_json(reconfcheck::geometry::EPSILON))?;
+            }
+            Ok(0)
+        }
+        Command::Render { picture, output } => {
+            let svg = reconfcheck::geometry::picture::svg(picture);
+            reconfcheck::render::save(&svg, &output, 1.0).map_err(Failure::Output)?;
+            eprintln!("wrote {}", output.display());
+            Ok(0)
         }
         Command::Algorithms => {
             for g in algorithms::registry() {

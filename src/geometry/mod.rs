@@ -6,6 +6,7 @@
 
 pub mod catom;
 pub mod fcc_sweep;
+pub mod picture;
 pub mod rolling;
 pub mod rules;
 pub mod sweep;

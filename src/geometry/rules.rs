@@ -231,6 +231,123 @@ impl RuleTable {
     }
 }
 
+impl RuleTable {
+    /// The table as text: one line per link, cells written relative to a
+    /// pivot at cell (0,0,0) (an even layer), the deepest penetration, the
+    /// sliding cells and the pinches.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let o = Cell::new(0, 0, 0);
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "# Derived motion rules: {} rotation links of a pivot at (0,0,0); connector numbering of lattice::fcc.",
+            self.links.len()
+        );
+        let _ = writeln!(
+            out,
+            "# blocking: cells whose occupant the sweep penetrates by more than ε (target excluded); max depth in d."
+        );
+        let _ = writeln!(
+            out,
+            "# sliding: cells touched within ±ε away from the latched ends; pinch: two sliding cells on opposite sides."
+        );
+        let _ = writeln!(
+            out,
+            "{:<12} {:>4} {:>7}  blocking | sliding | pinches",
+            "link", "#blk", "depth"
+        );
+        for r in &self.links {
+            let target = Offset::between(o, FccLattice.neighbour(o, r.link.to as usize));
+            let blocking: Vec<&RuleEntry> = r
+                .entries
+                .iter()
+                .filter(|e| e.kind == ContactKind::Collision && e.offset != target)
+                .collect();
+            let depth = blocking.iter().map(|e| e.depth).fold(0.0, f64::max);
+            let cells = |es: &mut dyn Iterator<Item = Offset>| {
+                es.map(|x| x.from(o).to_string())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            };
+            let sliding = cells(
+                &mut r
+                    .entries
+                    .iter()
+                    .filter(|e| e.kind == ContactKind::SlidingContact)
+                    .map(|e| e.offset),
+            );
+            let pinches: Vec<String> = r
+                .pinches
+                .iter()
+                .map(|(a, b)| format!("{}+{}", a.from(o), b.from(o)))
+                .collect();
+            let _ = writeln!(
+                out,
+                "{:<12} {:>4} {:>7.4}  {} | {} | {}",
+                r.link.to_string(),
+                blocking.len(),
+                depth,
+                cells(&mut blocking.iter().map(|e| e.offset)),
+                if sliding.is_empty() {
+                    "-".into()
+                } else {
+                    sliding
+                },
+                if pinches.is_empty() {
+                    "-".into()
+                } else {
+                    pinches.join(" ")
+                },
+            );
+        }
+        out
+    }
+
+    /// The table as JSON (`format: "reconfcheck-rules"`).
+    pub fn to_json(&self, eps: f64) -> String {
+        let o = Cell::new(0, 0, 0);
+        let links: Vec<serde_json::Value> = self
+            .links
+            .iter()
+            .map(|r| {
+                let entries: Vec<serde_json::Value> = r
+                    .entries
+                    .iter()
+                    .map(|e| {
+                        serde_json::json!({
+                            "cell": e.offset.from(o),
+                            "offset": e.offset,
+                            "kind": e.kind,
+                            "s": e.s,
+                            "depth": e.depth,
+                            "witness_mover": e.witness_mover.to_array(),
+                            "witness_other": e.witness_other.to_array(),
+                        })
+                    })
+                    .collect();
+                serde_json::json!({
+                    "from": r.link.from,
+                    "to": r.link.to,
+                    "route": r.link.route,
+                    "via": r.link.via().map(|v| v.to_array()),
+                    "target": FccLattice.neighbour(o, r.link.to as usize),
+                    "entries": entries,
+                    "pinches": r.pinches.iter().map(|(a, b)| [a.from(o), b.from(o)]).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        serde_json::to_string_pretty(&serde_json::json!({
+            "format": "reconfcheck-rules",
+            "version": 1,
+            "epsilon": eps,
+            "pivot": o,
+            "links": links,
+        }))
+        .expect("rules serialise")
+    }
+}
+
 /// The table at the default tolerance, derived on first use.
 pub fn table() -> &'static RuleTable {
     static TABLE: OnceLock<RuleTable> = OnceLock::new();
@@ -414,5 +531,61 @@ mod tests {
         // On hexagonal routes neither module alone blocks: the mover slides
         // flush between them (zero clearance), which the pinch rule forbids.
         assert!(pinch_only > 0);
+    }
+
+    #[test]
+    fn text_and_json_list_all_120_links() {
+        let t = table();
+        let text = t.to_text();
+        assert_eq!(
+            text.lines()
+                .filter(|l| l.contains(" hex ") || l.contains(" oct "))
+                .count(),
+            120
+        );
+        assert!(text.contains(" 0→1  oct"));
+        let v: serde_json::Value = serde_json::from_str(&t.to_json(EPSILON)).unwrap();
+        assert_eq!(v["links"].as_array().unwrap().len(), 120);
+        let first = &v["links"][0];
+        assert!(
+            first["entries"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|e| e["kind"] == "collision")
+        );
+    }
+
+    /// The lattice's symmetry maps links of one class onto each other, so
+    /// an independent derivation per link must give the same counts within
+    /// each class: hexagonal 60°, octagonal 60° and octagonal 90°.
+    #[test]
+    fn derivation_respects_the_lattice_symmetry() {
+        let o = Cell::new(0, 0, 0);
+        let mut classes: std::collections::BTreeMap<(Route, bool), Vec<(usize, usize, usize)>> =
+            Default::default();
+        for r in &table().links {
+            let target = Offset::between(o, FccLattice.neighbour(o, r.link.to as usize));
+            let blocking = r.blocking().filter(|b| *b != target).count();
+            let sliding = r
+                .entries
+                .iter()
+                .filter(|e| e.kind == ContactKind::SlidingContact)
+                .count();
+            classes
+                .entry((r.link.route, r.link.is_right_angle()))
+                .or_default()
+                .push((blocking, sliding, r.pinches.len()));
+        }
+        let expect = [
+            ((Route::Hexagonal, false), 48, (6, 3, 2)),
+            ((Route::Octagonal, false), 48, (8, 0, 0)),
+            ((Route::Octagonal, true), 24, (9, 0, 0)),
+        ];
+        for (class, n, counts) in expect {
+            let v = &classes[&class];
+            assert_eq!(v.len(), n, "{class:?}");
+            assert!(v.iter().all(|c| *c == counts), "{class:?}: {v:?}");
+        }
     }
 }
