@@ -10,6 +10,8 @@ use glam::DVec3;
 use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 
+pub mod square;
+
 /// Default certification tolerance, in units of the lattice spacing d.
 pub const EPSILON: f64 = 1e-6;
 
@@ -65,7 +67,8 @@ pub trait SweepModel: Send + Sync {
 /// The sweep model of a lattice, if this build has a body model for it.
 pub fn sweep_model(kind: LatticeKind) -> Option<&'static dyn SweepModel> {
     match kind {
-        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+        LatticeKind::Square => Some(&square::SquareSweep),
+        LatticeKind::Fcc | LatticeKind::Cubic => None,
     }
 }
 
@@ -81,7 +84,9 @@ pub trait MotionRules: Send + Sync {
     /// Whether `motion` is free of collisions with static modules, given
     /// which cells are occupied at the start of the step.
     fn allows(&self, motion: &Motion, occupied: &dyn Fn(crate::lattice::Cell) -> bool) -> bool {
-        self.blocking_cells(motion).into_iter().all(|c| !occupied(c))
+        self.blocking_cells(motion)
+            .into_iter()
+            .all(|c| !occupied(c))
     }
 }
 

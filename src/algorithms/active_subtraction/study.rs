@@ -1,0 +1,1 @@
+//! Density study (seed 003 §V-B1).
