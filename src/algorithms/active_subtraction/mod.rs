@@ -27,6 +27,7 @@ use rustc_hash::FxHashSet;
 use sas::{SINK, SasRun};
 use serde::Deserialize;
 pub use shape::Shape;
+use shape::xy;
 
 /// Sequential or parallel active subtraction.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Deserialize)]
@@ -94,7 +95,7 @@ impl Plan {
         let run = sas::run(&shape)?;
         let times = match mode {
             Mode::Sas => PasTimes::sequential(&run),
-            Mode::Pas => pas::plan(&shape, &run),
+            Mode::Pas => pas::plan(&shape, &run)?,
         };
         let time_steps = times.time_steps();
         Ok(Plan {
@@ -283,7 +284,7 @@ fn emit(plan: &Plan) -> Result<Emitted, String> {
             if to != SINK {
                 config
                     .insert(id, to)
-                    .map_err(|o| format!("step {t}: modules {id} and {o} meet at {to}"))?;
+                    .map_err(|o| format!("step {t}: modules {id} and {o} meet at {}", xy(to)))?;
             }
         }
         s.steps.push(Step { events });

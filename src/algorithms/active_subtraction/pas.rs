@@ -13,7 +13,7 @@
 //! too. [`PasTimes`] reports how often each reason delayed a start.
 
 use super::sas::{Removal, SasRun, next_direction};
-use super::shape::{Shape, neighbours4};
+use super::shape::{Shape, neighbours4, xy};
 use crate::lattice::Cell;
 use rustc_hash::FxHashMap;
 
@@ -206,8 +206,10 @@ fn grounded(shape: &Shape, present: &dyn Fn(Cell) -> bool) -> bool {
     shape.cells().all(|c| !present(c) || seen[idx(c)])
 }
 
-/// Alg. 3: start times for the SAS removals of `run` on `shape`.
-pub fn plan(shape: &Shape, run: &SasRun) -> PasTimes {
+/// Alg. 3: start times for the SAS removals of `run` on `shape`. Fails
+/// only if `run` is not what SAS produces on `shape` (a route Alg. 2 would
+/// not take even with every earlier module gone).
+pub fn plan(shape: &Shape, run: &SasRun) -> Result<PasTimes, String> {
     let n = run.removals.len();
     let mut p = Planner {
         shape,
@@ -231,9 +233,17 @@ pub fn plan(shape: &Shape, run: &SasRun) -> PasTimes {
         };
         p.start.push(s);
         p.arrival.push(s + delta);
+        // Once every earlier module has arrived nothing can interfere.
+        let quiet = p.arrival[..k].iter().copied().max().map_or(0, |a| a + 1);
         loop {
             match p.check(k) {
                 Ok(()) => break,
+                Err(_) if s > quiet => {
+                    return Err(format!(
+                        "removal {k} from {} does not follow Alg. 2 on this configuration",
+                        xy(r.start())
+                    ));
+                }
                 Err(clash) => {
                     match clash {
                         Clash::Moore => out.delayed_moore += 1,
@@ -249,5 +259,79 @@ pub fn plan(shape: &Shape, run: &SasRun) -> PasTimes {
     }
     out.start = p.start;
     out.arrival = p.arrival;
-    out
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algorithms::active_subtraction::sas;
+    use std::path::Path;
+
+    fn shape(t: &str) -> Shape {
+        Shape::parse(t, Path::new("t")).unwrap()
+    }
+
+    #[test]
+    fn u_shape_start_times_are_delayed_only_by_moore_collisions() {
+        let u = shape("#..#\n#..#\n#..#\n####\n");
+        let run = sas::run(&u).unwrap();
+        let durations: Vec<usize> = run.removals.iter().map(Removal::duration).collect();
+        assert_eq!(durations, [5, 6, 6, 7, 7, 8]);
+        let t = plan(&u, &run).unwrap();
+        // Line 4 proposes 0, 1, 3, 4, 7, 8; the 4th and 6th would start
+        // next to the module ahead of them and wait one step.
+        assert_eq!(t.start, [0, 1, 3, 5, 7, 9]);
+        assert_eq!(t.arrival, [5, 7, 9, 12, 14, 17]);
+        assert_eq!(
+            (t.delayed_moore, t.delayed_route, t.delayed_support),
+            (2, 0, 0)
+        );
+    }
+
+    #[test]
+    fn a_route_alg_2_would_not_take_is_refused() {
+        let u = shape("#..#\n#..#\n#..#\n####\n");
+        let mut run = sas::run(&u).unwrap();
+        // Send the first module the long way round: East first.
+        let r = &mut run.removals[0];
+        r.cells.insert(1, Cell::xy(3, 5));
+        r.cells.insert(2, Cell::xy(2, 5));
+        let e = plan(&u, &run).unwrap_err();
+        assert!(e.contains("does not follow Alg. 2"), "{e}");
+    }
+
+    #[test]
+    fn starting_below_a_waiting_module_is_a_support_clash() {
+        // A column on one included module: (1,2) below (1,3).
+        let s = shape(".\n.\n#\n");
+        let top = Removal {
+            cells: vec![Cell::xy(1, 3), Cell::xy(0, 2), Cell::xy(0, 1)],
+        };
+        let low = Removal {
+            cells: vec![Cell::xy(1, 2), Cell::xy(0, 1)],
+        };
+        let removals = [top, low];
+        let planner = |start: Vec<usize>| Planner {
+            shape: &s,
+            removals: &removals,
+            owner: removals
+                .iter()
+                .enumerate()
+                .map(|(k, r)| (r.start(), k))
+                .collect(),
+            arrival: start
+                .iter()
+                .zip(&removals)
+                .map(|(s, r)| s + r.duration())
+                .collect(),
+            start,
+        };
+        // The lower module leaving first strands the upper one.
+        assert!(matches!(
+            planner(vec![5, 0]).check_support(1),
+            Err(Clash::Support)
+        ));
+        assert!(planner(vec![0, 4]).check_support(1).is_ok());
+    }
 }

@@ -2,7 +2,7 @@
 //! the next excluded module (Alg. 1) and the active module's walk to the
 //! sink with dynamic prioritisation (Alg. 2).
 
-use super::shape::{Shape, neighbours4};
+use super::shape::{Shape, neighbours4, xy};
 use crate::lattice::Cell;
 
 /// The sink of seed 003 §II, at ground level West of the rectangle.
@@ -192,7 +192,11 @@ pub fn walk(
             ));
         }
         let Some(d) = next_direction(p, last, occ) else {
-            return Err(format!("the module from {start} is boxed in at {p}"));
+            return Err(format!(
+                "the module from {} is boxed in at {}",
+                xy(start),
+                xy(p)
+            ));
         };
         p = d.step(p);
         if !tracked(p) {

@@ -155,15 +155,17 @@ impl Shape {
         let loose = self.disconnected();
         if let Some(c) = loose.first() {
             return Err(format!(
-                "the desired configuration is disconnected: {} included module(s) are not connected to the ground, e.g. at {c}",
-                loose.len()
+                "the desired configuration is disconnected: {} included module(s) are not connected to the ground, e.g. at {}",
+                loose.len(),
+                xy(*c)
             ));
         }
         let enclosed = self.enclosed();
         if let Some(c) = enclosed.first() {
             return Err(format!(
-                "the desired configuration is hollow: {} excluded cell(s) are enclosed by included modules and the ground, e.g. at {c}",
-                enclosed.len()
+                "the desired configuration is hollow: {} excluded cell(s) are enclosed by included modules and the ground, e.g. at {}",
+                enclosed.len(),
+                xy(*c)
             ));
         }
         Ok(())
@@ -237,6 +239,11 @@ impl Shape {
     }
 }
 
+/// A cell of the plane as the paper writes it, `(x, y)`.
+pub(crate) fn xy(c: Cell) -> String {
+    format!("({}, {})", c.x, c.y)
+}
+
 pub(crate) fn neighbours4(c: Cell) -> [Cell; 4] {
     [
         Cell::xy(c.x + 1, c.y),
@@ -269,7 +276,7 @@ mod tests {
     #[test]
     fn hollow_shapes_are_rejected() {
         let e = parse("###\n#.#\n###\n").unwrap_err();
-        assert!(e.contains("hollow") && e.contains("[2, 2"), "{e}");
+        assert!(e.contains("hollow") && e.contains("(2, 2)"), "{e}");
         // A pocket closed by the ground is hollow too.
         let e = parse("###\n#.#\n").unwrap_err();
         assert!(e.contains("hollow"), "{e}");
@@ -281,7 +288,7 @@ mod tests {
     #[test]
     fn disconnected_and_floating_shapes_are_rejected() {
         let e = parse("#..\n...\n..#\n").unwrap_err();
-        assert!(e.contains("disconnected") && e.contains("[1, 3"), "{e}");
+        assert!(e.contains("disconnected") && e.contains("(1, 3)"), "{e}");
         let e = parse("...\n...\n").unwrap_err();
         assert!(e.contains("no included module"), "{e}");
     }

@@ -106,7 +106,7 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
             let run = sas::run(&shape)?;
             let n = run.removals.len().max(1) as f64;
             let sas_t = PasTimes::sequential(&run).time_steps() as f64;
-            let pas_t = pas::plan(&shape, &run).time_steps() as f64;
+            let pas_t = pas::plan(&shape, &run)?.time_steps() as f64;
             Ok(Sample {
                 size,
                 density,
