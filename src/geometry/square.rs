@@ -16,7 +16,8 @@
 //! minimum of piecewise-linear functions: its maximum on each linear piece is
 //! at an end of the piece, where `r_x` or `r_y` crosses 0, or where
 //! `|r_x| = |r_y|`. Evaluating those points gives the exact deepest
-//! penetration — no sampling, no tunnelling.
+//! penetration — no sampling, no tunnelling, no compiled tables (so
+//! `SweepInput::exact` changes nothing here).
 //!
 //! Contacts reported: a `Collision` wherever the depth exceeds ε; a
 //! `SlidingContact` where a face slides along another module's face over a
@@ -270,8 +271,6 @@ impl SweepModel for SquareSweep {
                 }
             }
         }
-        // Leavers that do not move stay where they are: static for this model
-        // only if not in `moving`, which the loops above already respect.
         out
     }
 }
