@@ -276,14 +276,14 @@ fn pas_keeps_the_sas_order_and_routes_and_active_modules_out_of_each_others_moor
         let t = &pas_plan.times;
         let frames = replay(&pas);
         let ids: Vec<u32> = arrival_order(&pas);
-        for time in 0..frames.len() {
+        for (time, frame) in frames.iter().enumerate() {
             let active: Vec<Cell> = (0..ids.len())
                 .filter(|&i| t.start[i] <= time && time <= t.arrival[i])
                 .map(|i| {
                     if time == t.arrival[i] {
                         Cell::xy(0, 1)
                     } else {
-                        frames[time][&ids[i]]
+                        frame[&ids[i]]
                     }
                 })
                 .collect();

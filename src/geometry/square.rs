@@ -282,10 +282,10 @@ mod tests {
     use crate::lattice::{Configuration, SquareLattice};
     use rustc_hash::FxHashSet;
 
-    fn run(
-        statics: &[(i32, i32)],
-        moves: &[(ModuleId, (i32, i32), (i32, i32), Option<(i32, i32)>)],
-    ) -> Vec<Contact> {
+    type Xy = (i32, i32);
+
+    /// Sweeps `moves` (module, from, to, pivot cell) among static modules.
+    fn run(statics: &[Xy], moves: &[(ModuleId, Xy, Xy, Option<Xy>)]) -> Vec<Contact> {
         let mut config = Configuration::new();
         for (k, &(x, y)) in statics.iter().enumerate() {
             config.insert(100 + k as ModuleId, Cell::xy(x, y)).unwrap();

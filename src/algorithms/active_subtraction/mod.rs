@@ -246,10 +246,10 @@ fn emit(plan: &Plan) -> Result<Emitted, String> {
         .collect();
     let total = plan.time_steps;
     let mut by_step: Vec<Vec<usize>> = vec![Vec::new(); total + 1];
-    for (i, r) in plan.run.removals.iter().enumerate() {
-        for t in plan.times.start[i] + 1..=plan.times.arrival[i] {
-            debug_assert!(r.duration() > 0);
-            by_step[t].push(i);
+    for i in 0..plan.run.removals.len() {
+        let steps = plan.times.start[i] + 1..=plan.times.arrival[i];
+        for movers in &mut by_step[steps] {
+            movers.push(i);
         }
     }
     let mut unsupported = 0;

@@ -82,10 +82,13 @@ impl Planner<'_> {
         if c.y < 1 || self.shape.contains(c) {
             return true;
         }
-        if let Some(&m) = self.owner.get(&c) {
-            if m > k || t <= self.start[m] {
-                return true;
-            }
+        // A module still in its start cell: not yet scheduled, or not started.
+        if self
+            .owner
+            .get(&c)
+            .is_some_and(|&m| m > k || t <= self.start[m])
+        {
+            return true;
         }
         actives.iter().any(|&(_, p)| p == c)
     }
