@@ -353,14 +353,21 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
     );
     for s in &samples {
         assert!(s.pas < s.sas, "{s:?}");
+        assert!(
+            s.best <= s.sas,
+            "the best case bounds SAS from below: {s:?}"
+        );
         assert!(s.pas >= 1.0, "a module needs at least one move: {s:?}");
         let want = (s.size * s.size) as f64 * (1.0 - s.density as f64 / 100.0);
         assert_eq!(s.excluded, want.round() as usize);
     }
     let rows = study::summarise(&cfg, &samples);
     let median = |size, d, pas: bool| {
-        let r = rows.iter().find(|r| r.0 == size && r.1 == d).unwrap();
-        if pas { r.3.median } else { r.2.median }
+        let r = rows
+            .iter()
+            .find(|r| r.size == size && r.density == d)
+            .unwrap();
+        if pas { r.pas.median } else { r.sas.median }
     };
     for d in [10, 40, 70] {
         // SAS time per module grows with the perimeter it walks; PAS hides

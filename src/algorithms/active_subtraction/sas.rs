@@ -235,6 +235,37 @@ pub fn run(shape: &Shape) -> Result<SasRun, String> {
     Ok(SasRun { removals })
 }
 
+/// The *best-case sequential time* of seed 003 §V-B1, a lower bound for
+/// SAS: the sum over excluded modules of the shortest route to the sink
+/// through cells not held by included modules (excluded modules count as
+/// empty), by the paper's moves. A diagonal move needs one of its two
+/// adjacent cells free (the paper leaves the side open; either way round the
+/// corner is a valid route).
+pub fn best_case_time(shape: &Shape) -> usize {
+    let (x0, x1, y1) = (1 - MARGIN, shape.width + MARGIN, shape.height + MARGIN);
+    let w = (x1 - x0 + 1) as usize;
+    let idx = |c: Cell| (c.y - 1) as usize * w + (c.x - x0) as usize;
+    let open = |c: Cell| c.x >= x0 && c.x <= x1 && c.y >= 1 && c.y <= y1 && !shape.contains(c);
+    let mut dist = vec![usize::MAX; w * y1 as usize];
+    let mut queue = std::collections::VecDeque::from([SINK]);
+    dist[idx(SINK)] = 0;
+    while let Some(c) = queue.pop_front() {
+        for d in (0..8).map(|k| Dir::S.turn(k)) {
+            let n = d.step(c);
+            let passable = !d.is_diagonal() || open(d.turn(1).step(c)) || open(d.turn(-1).step(c));
+            if open(n) && passable && dist[idx(n)] == usize::MAX {
+                dist[idx(n)] = dist[idx(c)] + 1;
+                queue.push_back(n);
+            }
+        }
+    }
+    shape
+        .cells()
+        .filter(|&c| !shape.contains(c))
+        .map(|c| dist[idx(c)])
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -271,5 +302,11 @@ mod tests {
         for r in &run.removals {
             assert_eq!(*r.cells.last().unwrap(), SINK);
         }
+        // SAS takes 5 + 6 + 6 + 7 + 7 + 8; the best case cuts diagonally
+        // across the inside: (2,4) 5, (3,4) 6, (2,3) 6, (3,3) 6, (2,2) 7,
+        // (3,2) 7.
+        let best = best_case_time(&s);
+        assert_eq!(run.time_steps(), 39);
+        assert_eq!(best, 5 + 6 + 6 + 6 + 7 + 7);
     }
 }

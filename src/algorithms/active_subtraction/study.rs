@@ -33,6 +33,8 @@ pub struct Sample {
     /// Time steps per excluded module.
     pub sas: f64,
     pub pas: f64,
+    /// Best-case sequential time (a lower bound for SAS), normalised too.
+    pub best: f64,
 }
 
 /// Quartiles and whiskers (1.5 IQR, clipped to the data) of a sample set.
@@ -107,6 +109,7 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
             let n = run.removals.len().max(1) as f64;
             let sas_t = PasTimes::sequential(&run).time_steps() as f64;
             let pas_t = pas::plan(&shape, &run)?.time_steps() as f64;
+            let best = sas::best_case_time(&shape) as f64 / n;
             Ok(Sample {
                 size,
                 density,
@@ -114,26 +117,43 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
                 excluded: run.removals.len(),
                 sas: sas_t / n,
                 pas: pas_t / n,
+                best,
             })
         })
         .collect()
 }
 
-/// Per `(size, density)`: the SAS and PAS summaries.
-pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<(i32, u32, Summary, Summary)> {
+/// The summaries of one `(size, density)` box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    pub size: i32,
+    pub density: u32,
+    pub sas: Summary,
+    pub pas: Summary,
+    pub best: Summary,
+}
+
+/// Per `(size, density)`: the SAS, PAS and best-case summaries.
+pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<Row> {
     let mut out = Vec::new();
     for &size in &cfg.sizes {
-        for &d in &cfg.densities {
+        for &density in &cfg.densities {
             let of = |f: fn(&Sample) -> f64| -> Vec<f64> {
                 samples
                     .iter()
-                    .filter(|s| s.size == size && s.density == d)
+                    .filter(|s| s.size == size && s.density == density)
                     .map(f)
                     .collect()
             };
-            let (a, b) = (of(|s| s.sas), of(|s| s.pas));
+            let (a, b, c) = (of(|s| s.sas), of(|s| s.pas), of(|s| s.best));
             if !a.is_empty() {
-                out.push((size, d, Summary::of(&a), Summary::of(&b)));
+                out.push(Row {
+                    size,
+                    density,
+                    sas: Summary::of(&a),
+                    pas: Summary::of(&b),
+                    best: Summary::of(&c),
+                });
             }
         }
     }
@@ -141,12 +161,15 @@ pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<(i32, u32, Summar
 }
 
 /// The summary table, one row per `(size, density)`.
-pub fn table(rows: &[(i32, u32, Summary, Summary)]) -> String {
-    let mut s = String::from("size    rho  SAS q1 / median / q3        PAS q1 / median / q3\n");
-    for (size, d, a, b) in rows {
+pub fn table(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "size    rho  SAS q1 / median / q3        PAS q1 / median / q3    best-case median\n",
+    );
+    for r in rows {
+        let (size, d, a, b) = (r.size, r.density, r.sas, r.pas);
         s += &format!(
-            "{size:>2}x{size:<2}  {d:>2}%  {:>7.2} / {:>7.2} / {:>7.2}   {:>6.2} / {:>6.2} / {:>6.2}\n",
-            a.q1, a.median, a.q3, b.q1, b.median, b.q3
+            "{size:>2}x{size:<2}  {d:>2}%  {:>7.2} / {:>7.2} / {:>7.2}   {:>6.2} / {:>6.2} / {:>6.2}   {:>6.2}\n",
+            a.q1, a.median, a.q3, b.q1, b.median, b.q3, r.best.median
         );
     }
     s
@@ -154,23 +177,19 @@ pub fn table(rows: &[(i32, u32, Summary, Summary)]) -> String {
 
 /// Box plot of the normalised times (log scale), like the paper's Fig. 10:
 /// per density, SAS and PAS for each size (lighter boxes: smaller size).
-pub fn plot(
-    cfg: &StudyConfig,
-    rows: &[(i32, u32, Summary, Summary)],
-    path: &Path,
-) -> Result<(), String> {
+pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> {
     let mut svg = String::new();
     {
         let root = SvgCanvas::with_string(&mut svg, (960, 540)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let lo = rows
             .iter()
-            .map(|r| r.3.low.min(r.2.low))
+            .map(|r| r.pas.low.min(r.sas.low))
             .fold(f64::INFINITY, f64::min)
             .max(1e-3);
         let hi = rows
             .iter()
-            .map(|r| r.3.high.max(r.2.high))
+            .map(|r| r.pas.high.max(r.sas.high))
             .fold(0.0, f64::max)
             .max(lo * 2.0);
         let n = cfg.densities.len() as f64;
@@ -250,11 +269,15 @@ pub fn plot(
                 };
                 let boxes: Vec<(f64, Summary)> = rows
                     .iter()
-                    .filter(|r| r.0 == size)
+                    .filter(|r| r.size == size)
                     .map(|r| {
-                        let k = cfg.densities.iter().position(|&d| d == r.1).unwrap_or(0) as f64;
+                        let k = cfg
+                            .densities
+                            .iter()
+                            .position(|&d| d == r.density)
+                            .unwrap_or(0) as f64;
                         let x = k - 0.4 + width * (slot as f64 + 0.5);
-                        let v = if mi == 0 { r.2 } else { r.3 };
+                        let v = if mi == 0 { r.sas } else { r.pas };
                         let l = |x: f64| x.log10();
                         (
                             x,
@@ -298,6 +321,35 @@ pub fn plot(
                         .map_err(|e| e.to_string())?;
                 }
             }
+        }
+        // The paper's overlay: median best-case sequential time per size.
+        for (si, &size) in cfg.sizes.iter().enumerate() {
+            let light = si + 1 < cfg.sizes.len();
+            let style = if light {
+                BLACK.mix(0.45).stroke_width(2)
+            } else {
+                BLACK.stroke_width(2)
+            };
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.size == size)
+                .filter_map(|r| {
+                    let k = cfg.densities.iter().position(|&d| d == r.density)? as f64;
+                    Some((k, r.best.median.log10()))
+                })
+                .collect();
+            chart
+                .draw_series(LineSeries::new(points.clone(), style))
+                .map_err(|e| e.to_string())?
+                .label(format!("best case {size}×{size} (median)"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
+            chart
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 3, style.filled())),
+                )
+                .map_err(|e| e.to_string())?;
         }
         chart
             .configure_series_labels()
