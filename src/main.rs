@@ -76,6 +76,24 @@ enum Command {
     },
     /// List the generators (algorithms) scenarios can name.
     Algorithms,
+    /// Seed 003 §V-B1: active subtraction on random configurations of
+    /// several densities; prints a table and draws a box plot.
+    DensityStudy {
+        /// Side lengths of the initial squares.
+        #[arg(long, value_delimiter = ',', default_value = "10,20")]
+        sizes: Vec<i32>,
+        /// Densities of included modules, in percent.
+        #[arg(long, value_delimiter = ',', default_value = "10,20,30,40,50,60,70")]
+        densities: Vec<u32>,
+        /// Random configurations per (size, density).
+        #[arg(long, default_value_t = 80)]
+        samples: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Box plot (PNG, or SVG by extension).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Derive the FCC motion rules (cells blocking each of the 120 rotation
     /// links) from the catom geometry and print them as a table.
     Rules {
@@ -163,6 +181,36 @@ fn run(cmd: Command) -> Result<u8, Failure> {
         Command::Render { picture, output } => {
             let svg = reconfcheck::geometry::picture::svg(picture);
             reconfcheck::render::save(&svg, &output, 1.0).map_err(Failure::Output)?;
+            eprintln!("wrote {}", output.display());
+            Ok(0)
+        }
+        Command::DensityStudy {
+            sizes,
+            densities,
+            samples,
+            seed,
+            output,
+        } => {
+            use reconfcheck::algorithms::active_subtraction::study;
+            let cfg = study::StudyConfig {
+                sizes,
+                densities,
+                samples,
+                seed,
+            };
+            let bad = |m: String| Failure::Input(InputError::new(m));
+            if cfg.samples == 0
+                || cfg.sizes.iter().any(|&s| s < 2)
+                || cfg.densities.iter().any(|&d| d == 0 || d >= 100)
+            {
+                return Err(bad(
+                    "density-study needs samples ≥ 1, sizes ≥ 2 and densities in 1..99 %".into(),
+                ));
+            }
+            let samples = study::run(&cfg).map_err(bad)?;
+            let rows = study::summarise(&cfg, &samples);
+            print!("{}", study::table(&rows));
+            study::plot(&cfg, &rows, &output).map_err(Failure::Output)?;
             eprintln!("wrote {}", output.display());
             Ok(0)
         }

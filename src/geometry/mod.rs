@@ -17,6 +17,8 @@ use glam::DVec3;
 use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 
+pub mod square;
+
 /// Default certification tolerance, in units of the lattice spacing d.
 pub const EPSILON: f64 = 1e-6;
 
@@ -73,7 +75,8 @@ pub trait SweepModel: Send + Sync {
 pub fn sweep_model(kind: LatticeKind) -> Option<&'static dyn SweepModel> {
     match kind {
         LatticeKind::Fcc => Some(&fcc_sweep::FccSweep),
-        LatticeKind::Square | LatticeKind::Cubic => None,
+        LatticeKind::Square => Some(&square::SquareSweep),
+        LatticeKind::Cubic => None,
     }
 }
 

@@ -1,0 +1,364 @@
+//! The density study of seed 003 §V-B1 (Fig. 10): random desired
+//! configurations of densities 10–70 % in 10 × 10 and 20 × 20 squares, the
+//! same samples for SAS and PAS, time normalised by the number of excluded
+//! modules; a table and a box plot.
+
+use super::pas::{self, PasTimes};
+use super::random::random_shape;
+use super::sas;
+use crate::render::{SvgCanvas, save};
+use plotters::prelude::*;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// What to sample.
+#[derive(Clone, Debug)]
+pub struct StudyConfig {
+    /// Side lengths of the initial squares.
+    pub sizes: Vec<i32>,
+    /// Densities ρ in percent.
+    pub densities: Vec<u32>,
+    pub samples: usize,
+    /// Base seed; sample `k` of `(size, ρ)` uses a seed derived from all four.
+    pub seed: u64,
+}
+
+/// One random configuration, run with both solutions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    pub size: i32,
+    pub density: u32,
+    pub seed: u64,
+    pub excluded: usize,
+    /// Time steps per excluded module.
+    pub sas: f64,
+    pub pas: f64,
+    /// Best-case sequential time (a lower bound for SAS), normalised too.
+    pub best: f64,
+}
+
+/// Quartiles and whiskers (1.5 IQR, clipped to the data) of a sample set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Summary {
+    pub low: f64,
+    pub q1: f64,
+    pub median: f64,
+    pub q3: f64,
+    pub high: f64,
+}
+
+impl Summary {
+    pub fn of(values: &[f64]) -> Summary {
+        let mut v = values.to_vec();
+        v.sort_by(f64::total_cmp);
+        let q = |p: f64| {
+            let x = p * (v.len() - 1) as f64;
+            let (i, f) = (x.floor() as usize, x.fract());
+            if i + 1 < v.len() {
+                v[i] * (1.0 - f) + v[i + 1] * f
+            } else {
+                v[i]
+            }
+        };
+        let (q1, median, q3) = (q(0.25), q(0.5), q(0.75));
+        let iqr = q3 - q1;
+        let low = v
+            .iter()
+            .copied()
+            .find(|&x| x >= q1 - 1.5 * iqr)
+            .unwrap_or(q1);
+        let high = v
+            .iter()
+            .rev()
+            .copied()
+            .find(|&x| x <= q3 + 1.5 * iqr)
+            .unwrap_or(q3);
+        Summary {
+            low,
+            q1,
+            median,
+            q3,
+            high,
+        }
+    }
+}
+
+fn sample_seed(base: u64, size: i32, density: u32, k: usize) -> u64 {
+    base.wrapping_mul(1_000_003)
+        .wrapping_add(size as u64 * 1_000_000)
+        .wrapping_add(density as u64 * 10_000)
+        .wrapping_add(k as u64)
+}
+
+/// Runs the study (in parallel over samples). Deterministic for a config.
+pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
+    let jobs: Vec<(i32, u32, usize)> = cfg
+        .sizes
+        .iter()
+        .flat_map(|&s| {
+            cfg.densities
+                .iter()
+                .flat_map(move |&d| (0..cfg.samples).map(move |k| (s, d, k)))
+        })
+        .collect();
+    jobs.par_iter()
+        .map(|&(size, density, k)| {
+            let seed = sample_seed(cfg.seed, size, density, k);
+            let shape = random_shape(size, size, density as f64 / 100.0, seed)?;
+            let run = sas::run(&shape)?;
+            let n = run.removals.len().max(1) as f64;
+            let sas_t = PasTimes::sequential(&run).time_steps() as f64;
+            let pas_t = pas::plan(&shape, &run)?.time_steps() as f64;
+            let best = sas::best_case_time(&shape) as f64 / n;
+            Ok(Sample {
+                size,
+                density,
+                seed,
+                excluded: run.removals.len(),
+                sas: sas_t / n,
+                pas: pas_t / n,
+                best,
+            })
+        })
+        .collect()
+}
+
+/// The summaries of one `(size, density)` box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    pub size: i32,
+    pub density: u32,
+    pub sas: Summary,
+    pub pas: Summary,
+    pub best: Summary,
+}
+
+/// Per `(size, density)`: the SAS, PAS and best-case summaries.
+pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<Row> {
+    let mut out = Vec::new();
+    for &size in &cfg.sizes {
+        for &density in &cfg.densities {
+            let of = |f: fn(&Sample) -> f64| -> Vec<f64> {
+                samples
+                    .iter()
+                    .filter(|s| s.size == size && s.density == density)
+                    .map(f)
+                    .collect()
+            };
+            let (a, b, c) = (of(|s| s.sas), of(|s| s.pas), of(|s| s.best));
+            if !a.is_empty() {
+                out.push(Row {
+                    size,
+                    density,
+                    sas: Summary::of(&a),
+                    pas: Summary::of(&b),
+                    best: Summary::of(&c),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The summary table, one row per `(size, density)`.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "size    rho  SAS q1 / median / q3        PAS q1 / median / q3    best-case median\n",
+    );
+    for r in rows {
+        let (size, d, a, b) = (r.size, r.density, r.sas, r.pas);
+        s += &format!(
+            "{size:>2}x{size:<2}  {d:>2}%  {:>7.2} / {:>7.2} / {:>7.2}   {:>6.2} / {:>6.2} / {:>6.2}   {:>6.2}\n",
+            a.q1, a.median, a.q3, b.q1, b.median, b.q3, r.best.median
+        );
+    }
+    s
+}
+
+/// Box plot of the normalised times (log scale), like the paper's Fig. 10:
+/// per density, SAS and PAS for each size (lighter boxes: smaller size).
+pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> {
+    let mut svg = String::new();
+    {
+        let root = SvgCanvas::with_string(&mut svg, (960, 540)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let lo = rows
+            .iter()
+            .map(|r| r.pas.low.min(r.sas.low))
+            .fold(f64::INFINITY, f64::min)
+            .max(1e-3);
+        let hi = rows
+            .iter()
+            .map(|r| r.pas.high.max(r.sas.high))
+            .fold(0.0, f64::max)
+            .max(lo * 2.0);
+        let n = cfg.densities.len() as f64;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "Active subtraction: time per excluded module ({} samples per box)",
+                    cfg.samples
+                ),
+                ("sans-serif", 20),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-0.5..n - 0.5, (lo / 1.5).log10()..(hi * 4.0).log10())
+            .map_err(|e| e.to_string())?;
+        let densities = cfg.densities.clone();
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(cfg.densities.len() + 1)
+            .x_label_formatter(&|x| {
+                let k = x.round();
+                if (x - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < densities.len() {
+                    format!("{} %", densities[k as usize])
+                } else {
+                    String::new()
+                }
+            })
+            .disable_y_mesh()
+            .y_labels(0)
+            .x_desc("density of included modules ρ")
+            .y_desc("time steps / excluded module")
+            .draw()
+            .map_err(|e| e.to_string())?;
+        // Log scale by hand: the axis is log10 of the value, with ticks at
+        // 1-2-5 steps (plotters' log axis labels decades only).
+        let (y0, y1) = ((lo / 1.5).log10(), (hi * 4.0).log10());
+        let ticks: Vec<f64> = (-3..4)
+            .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+            .filter(|t| (y0..=y1).contains(&t.log10()))
+            .collect();
+        let grey = RGBColor(200, 200, 200);
+        for &t in &ticks {
+            let y = t.log10();
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(-0.5, y), (n - 0.5, y)],
+                    grey,
+                )))
+                .map_err(|e| e.to_string())?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!("{t}"),
+                    (-0.5 - 0.02 * n, y),
+                    ("sans-serif", 13).into_font().color(&BLACK).pos(
+                        plotters::style::text_anchor::Pos::new(
+                            plotters::style::text_anchor::HPos::Right,
+                            plotters::style::text_anchor::VPos::Center,
+                        ),
+                    ),
+                )))
+                .map_err(|e| e.to_string())?;
+        }
+        let kinds = cfg.sizes.len() * 2;
+        let width = 0.8 / kinds as f64;
+        let sas_c = RGBColor(31, 119, 180);
+        let pas_c = RGBColor(255, 127, 14);
+        for (si, &size) in cfg.sizes.iter().enumerate() {
+            for (mi, (name, colour)) in [("SAS", sas_c), ("PAS", pas_c)].into_iter().enumerate() {
+                let slot = si * 2 + mi;
+                let light = si + 1 < cfg.sizes.len();
+                let fill = if light {
+                    colour.mix(0.35).filled()
+                } else {
+                    colour.mix(0.85).filled()
+                };
+                let boxes: Vec<(f64, Summary)> = rows
+                    .iter()
+                    .filter(|r| r.size == size)
+                    .map(|r| {
+                        let k = cfg
+                            .densities
+                            .iter()
+                            .position(|&d| d == r.density)
+                            .unwrap_or(0) as f64;
+                        let x = k - 0.4 + width * (slot as f64 + 0.5);
+                        let v = if mi == 0 { r.sas } else { r.pas };
+                        let l = |x: f64| x.log10();
+                        (
+                            x,
+                            Summary {
+                                low: l(v.low),
+                                q1: l(v.q1),
+                                median: l(v.median),
+                                q3: l(v.q3),
+                                high: l(v.high),
+                            },
+                        )
+                    })
+                    .collect();
+                let half = width * 0.4;
+                chart
+                    .draw_series(
+                        boxes.iter().map(|&(x, s)| {
+                            Rectangle::new([(x - half, s.q1), (x + half, s.q3)], fill)
+                        }),
+                    )
+                    .map_err(|e| e.to_string())?
+                    .label(format!("{name} {size}×{size}"))
+                    .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], fill));
+                let black = BLACK.stroke_width(1);
+                for &(x, s) in &boxes {
+                    let lines = [
+                        vec![(x - half, s.median), (x + half, s.median)],
+                        vec![(x, s.q3), (x, s.high)],
+                        vec![(x, s.q1), (x, s.low)],
+                        vec![(x - half / 2.0, s.high), (x + half / 2.0, s.high)],
+                        vec![(x - half / 2.0, s.low), (x + half / 2.0, s.low)],
+                    ];
+                    chart
+                        .draw_series(lines.into_iter().map(|l| PathElement::new(l, black)))
+                        .map_err(|e| e.to_string())?;
+                    chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [(x - half, s.q1), (x + half, s.q3)],
+                            black,
+                        )))
+                        .map_err(|e| e.to_string())?;
+                }
+            }
+        }
+        // The paper's overlay: median best-case sequential time per size.
+        for (si, &size) in cfg.sizes.iter().enumerate() {
+            let light = si + 1 < cfg.sizes.len();
+            let style = if light {
+                BLACK.mix(0.45).stroke_width(2)
+            } else {
+                BLACK.stroke_width(2)
+            };
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.size == size)
+                .filter_map(|r| {
+                    let k = cfg.densities.iter().position(|&d| d == r.density)? as f64;
+                    Some((k, r.best.median.log10()))
+                })
+                .collect();
+            chart
+                .draw_series(LineSeries::new(points.clone(), style))
+                .map_err(|e| e.to_string())?
+                .label(format!("best case {size}×{size} (median)"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
+            chart
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, 3, style.filled())),
+                )
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    save(&svg, path, 1.0)
+}
