@@ -16,6 +16,7 @@ pub mod certify;
 pub mod error;
 pub mod geometry;
 pub mod lattice;
+pub mod mechanics;
 pub mod render;
 pub mod scenario;
 pub mod schedule;

@@ -52,9 +52,10 @@ pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
 
 /// Reads a generator's parameters from the scenario's `[parameters]` table.
 pub fn parameters<P: DeserializeOwned>(scenario: &Scenario) -> Result<P, InputError> {
-    scenario
-        .parameters
-        .clone()
-        .try_into()
-        .map_err(|e| scenario.error(format!("bad [parameters] for '{}': {e}", scenario.algorithm)))
+    scenario.parameters.clone().try_into().map_err(|e| {
+        scenario.error(format!(
+            "bad [parameters] for '{}': {e}",
+            scenario.algorithm
+        ))
+    })
 }
