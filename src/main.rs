@@ -48,6 +48,10 @@ struct ReportArgs {
     /// Run the lattice checks only (occupancy, pivots, connectivity).
     #[arg(long)]
     lattice_only: bool,
+    /// Physical model (TOML, see models/) for the gravity and connector-load
+    /// check; overrides the schedule's own `model`.
+    #[arg(long, value_name = "FILE")]
+    model: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -153,6 +157,8 @@ fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<
         exact: args.exact,
         epsilon: args.epsilon,
         lattice_only: args.lattice_only,
+        model: args.model.clone(),
+        base_dir: origin.parent().map(Path::to_path_buf),
     };
     let report: Report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
     let json = report.to_json();

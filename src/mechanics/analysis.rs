@@ -177,15 +177,22 @@ fn body_loads(s: &Structure) -> Vec<Vec6> {
     f
 }
 
-/// The offset with the largest horizontal lever (component across gravity).
+/// The offset with the largest horizontal lever (component across gravity);
+/// among equal levers (to 1e-9 d) the latest one, so that a mover sweeping
+/// a horizontal arc is taken at its target cell.
 fn worst_lever(offsets: impl Iterator<Item = DVec3>, g: DVec3) -> DVec3 {
-    offsets
-        .max_by(|a, b| {
-            let ha = (*a - a.dot(g) * g).length_squared();
-            let hb = (*b - b.dot(g) * g).length_squared();
-            ha.total_cmp(&hb)
-        })
-        .unwrap_or(DVec3::ZERO)
+    let mut best = DVec3::ZERO;
+    let mut best_h = -1.0;
+    for r in offsets {
+        let h = (r - r.dot(g) * g).length();
+        if h >= best_h - 1e-9 {
+            if h > best_h {
+                best_h = h;
+            }
+            best = r;
+        }
+    }
+    best
 }
 
 /// A component's cached solution.
