@@ -20,5 +20,6 @@ pub mod mechanics;
 pub mod render;
 pub mod scenario;
 pub mod schedule;
+pub mod study;
 
 pub use error::InputError;

@@ -4,6 +4,7 @@
 //! a scenario file names one by its [`Generator::name`]. Generators depend
 //! on the lattice and schedule layers only, never on certification.
 
+pub mod branch;
 pub mod random_walk;
 pub mod schedule_file;
 
@@ -23,7 +24,11 @@ pub trait Generator: Sync {
 
 /// Every generator this build knows.
 pub fn registry() -> Vec<&'static dyn Generator> {
-    vec![&schedule_file::ScheduleFile, &random_walk::RandomWalk]
+    vec![
+        &schedule_file::ScheduleFile,
+        &random_walk::RandomWalk,
+        &branch::Branch,
+    ]
 }
 
 /// Finds the generator a scenario names.

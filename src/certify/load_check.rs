@@ -185,6 +185,51 @@ impl StepCheck for LoadCheck {
     }
 }
 
+/// Replays `schedule` and analyses every intermediate structure (and the
+/// final one, reported as step `steps + 1`), handing each to `visit` with
+/// the step's lattice-check findings. Used by the b-study, the load map and
+/// the benchmarks; `incremental` selects reuse between steps.
+pub fn replay(
+    schedule: &crate::schedule::Schedule,
+    model: &Model,
+    incremental: bool,
+    mut visit: impl FnMut(usize, &Structure, &Analysis, &StepOutcome),
+) -> Result<(), crate::error::InputError> {
+    let check = LoadCheck::new(model, schedule.spacing.metres(), incremental);
+    let mut world = World::initial(schedule)?;
+    for (k, step) in schedule.steps.iter().enumerate() {
+        let plan = world.resolve(k + 1, step)?;
+        let mut out = StepOutcome {
+            violations: plan.violations.clone(),
+            ..Default::default()
+        };
+        let ctx = StepContext {
+            world: &world,
+            plan: &plan,
+        };
+        super::LatticeCheck.check(&ctx, &mut out);
+        let movers: Vec<MoverSpec> = plan
+            .moves
+            .iter()
+            .filter(|m| m.pivot_resolved)
+            .map(|m| (m.module, m.pivot, m.motion.clone()))
+            .collect();
+        let (s, a) = check.analyse(&world, &plan.moving, &movers);
+        visit(k + 1, &s, &a, &out);
+        let clashes = world.apply(&plan);
+        if !clashes.is_empty() {
+            return Err(crate::error::InputError::new(format!(
+                "step {}: {}",
+                k + 1,
+                clashes[0].message
+            )));
+        }
+    }
+    let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
+    visit(schedule.steps.len() + 1, &s, &a, &StepOutcome::default());
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
