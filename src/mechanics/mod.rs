@@ -15,6 +15,7 @@
 pub mod analysis;
 pub mod capacity;
 pub mod closed_form;
+pub mod dynamics;
 pub mod loadmap;
 pub mod model;
 pub mod solver;
