@@ -10,7 +10,7 @@
 
 use super::capacity::{ConnectorLoad, Mode, utilisation};
 use super::model::{Capacity, Model};
-use super::solver::{Block, BlockMatrix, SolveStats, Vec6, pcg};
+use super::solver::{Block, BlockMatrix, Multigrid, SolveStats, Vec6, mg_pcg, pcg, transfer};
 use super::structure::{End, Link, Structure};
 use glam::DVec3;
 use nalgebra::Matrix3;
@@ -93,6 +93,9 @@ pub struct Settings {
     pub tolerance: f64,
     /// Rounds of releasing ground contacts in tension.
     pub max_release_rounds: usize,
+    /// Components with at least this many modules use the multigrid
+    /// preconditioner, smaller ones block Jacobi.
+    pub multigrid_from: usize,
 }
 
 impl Default for Settings {
@@ -100,6 +103,7 @@ impl Default for Settings {
         Settings {
             tolerance: 1e-10,
             max_release_rounds: 30,
+            multigrid_from: MULTIGRID_FROM,
         }
     }
 }
@@ -129,16 +133,17 @@ impl Springs {
     }
 }
 
-fn skew(r: DVec3) -> Matrix3<f64> {
-    Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
-}
-
-/// `G(r)`: generalised displacement (translation, rotation) of the point at
-/// offset `r` from a body's centre, from the body's `(u, θ)`.
-fn transfer(r: DVec3) -> Block {
-    let mut g = Block::identity();
-    g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-skew(r)));
-    g
+/// Stiffness blocks of one link geometry (normal, kind), shared by every
+/// link of the same direction: `D` (interface), `G_a`, `G_b`, and the
+/// three blocks `G_aᵀDG_a`, `G_bᵀDG_b`, `−G_aᵀDG_b`.
+#[derive(Clone, Debug)]
+struct LinkBlocks {
+    d: Block,
+    ga: Block,
+    gb: Block,
+    kaa: Block,
+    kbb: Block,
+    kab: Block,
 }
 
 fn v3(v: DVec3) -> nalgebra::Vector3<f64> {
@@ -215,7 +220,12 @@ pub struct Analyzer {
     ground_springs: Springs,
     cache: FxHashMap<u64, Cached>,
     warm: FxHashMap<u32, Vec6>,
+    blocks: FxHashMap<([u64; 3], bool, bool), LinkBlocks>,
 }
+
+/// Components at least this large are solved with the multigrid
+/// preconditioner; smaller ones with block Jacobi.
+pub const MULTIGRID_FROM: usize = 64;
 
 impl Analyzer {
     pub fn new(model: Model, incremental: bool) -> Analyzer {
@@ -229,6 +239,7 @@ impl Analyzer {
             ground_springs,
             cache: FxHashMap::default(),
             warm: FxHashMap::default(),
+            blocks: FxHashMap::default(),
         }
     }
 
@@ -236,6 +247,43 @@ impl Analyzer {
     pub fn reset(&mut self) {
         self.cache.clear();
         self.warm.clear();
+    }
+
+    /// The stiffness blocks of a link (cached by geometry: every link of a
+    /// lattice direction has its contact at ±n·d/2 from both centres).
+    fn link_blocks(&mut self, s: &Structure, l: &Link, sliding: bool) -> LinkBlocks {
+        let ra = l.contact - s.bodies[l.a].centre;
+        let rb = match l.b {
+            End::Body(b) => Some(l.contact - s.bodies[b].centre),
+            End::Ground(_) => None,
+        };
+        let key = (
+            l.normal.to_array().map(f64::to_bits),
+            l.is_ground(),
+            sliding,
+        );
+        let standard = (ra - 0.5 * l.normal).length() < 1e-12
+            && rb.is_none_or(|r| (r + 0.5 * l.normal).length() < 1e-12);
+        if standard {
+            if let Some(b) = self.blocks.get(&key) {
+                return b.clone();
+            }
+        }
+        let d = link_stiffness(l, &self.link_springs(l, sliding));
+        let ga = transfer(ra);
+        let gb = rb.map_or(Block::identity(), transfer);
+        let b = LinkBlocks {
+            kaa: ga.transpose() * d * ga,
+            kbb: gb.transpose() * d * gb,
+            kab: -(ga.transpose() * d * gb),
+            d,
+            ga,
+            gb,
+        };
+        if standard {
+            self.blocks.insert(key, b.clone());
+        }
+        b
     }
 
     fn capacity(&self, link: &Link) -> &Capacity {
@@ -479,7 +527,7 @@ impl Analyzer {
     }
 
     fn link_load(
-        &self,
+        &mut self,
         s: &Structure,
         l: &Link,
         q: &[Vec6],
@@ -505,23 +553,22 @@ impl Analyzer {
     /// The link's load in its frame, and the force and moment side `a`
     /// exerts on side `b` (world, SI).
     fn link_forces(
-        &self,
+        &mut self,
         s: &Structure,
         l: &Link,
         q: &[Vec6],
         local: &[u32],
         sliding: bool,
     ) -> (ConnectorLoad, DVec3, DVec3) {
-        let d = link_stiffness(l, &self.link_springs(l, sliding));
+        let lb = self.link_blocks(s, l, sliding);
         let mut e = Vec6::zeros();
         if let Some(a) = self.side(s, End::Body(l.a), local) {
-            e -= transfer(l.contact - s.bodies[l.a].centre) * q[a];
+            e -= lb.ga * q[a];
         }
         if let Some(b) = self.side(s, l.b, local) {
-            let End::Body(bi) = l.b else { unreachable!() };
-            e += transfer(l.contact - s.bodies[bi].centre) * q[b];
+            e += lb.gb * q[b];
         }
-        let sf = d * e;
+        let sf = lb.d * e;
         let f = DVec3::new(sf[0], sf[1], sf[2]);
         let m = DVec3::new(sf[3], sf[4], sf[5]);
         let axial = f.dot(l.normal);
@@ -569,42 +616,43 @@ impl Analyzer {
         let mut sliding: Vec<usize> = Vec::new();
         for _round in 0..=self.settings.max_release_rounds {
             let mut k = BlockMatrix::new(n);
+            k.off.reserve(links.len());
             let mut anchored = false;
             for &li in links {
                 if released.contains(&li) {
                     continue;
                 }
                 let l = &s.links[li];
-                let d = link_stiffness(l, &self.link_springs(l, sliding.contains(&li)));
+                let lb = self.link_blocks(s, l, sliding.contains(&li));
                 let ia = self.side(s, End::Body(l.a), local);
                 let ib = self.side(s, l.b, local);
                 if ia.is_none() || ib.is_none() {
                     anchored = true;
                 }
-                let ga = transfer(l.contact - s.bodies[l.a].centre);
-                let gb = match l.b {
-                    End::Body(b) => transfer(l.contact - s.bodies[b].centre),
-                    End::Ground(_) => Block::identity(),
-                };
                 if let Some(a) = ia {
-                    k.diag[a] += ga.transpose() * d * ga;
+                    k.diag[a] += lb.kaa;
                 }
                 if let Some(b) = ib {
-                    k.diag[b] += gb.transpose() * d * gb;
+                    k.diag[b] += lb.kbb;
                 }
                 if let (Some(a), Some(b)) = (ia, ib) {
-                    let kab = -(ga.transpose() * d * gb);
                     if a < b {
-                        k.off.push((a as u32, b as u32, kab));
+                        k.off.push((a as u32, b as u32, lb.kab));
                     } else {
-                        k.off.push((b as u32, a as u32, kab.transpose()));
+                        k.off.push((b as u32, a as u32, lb.kab.transpose()));
                     }
                 }
             }
             if !anchored {
                 return None;
             }
-            let stats: SolveStats = pcg(&k, &f, &mut q, self.settings.tolerance, 50 * 6 * n + 1000);
+            let stats: SolveStats = if n >= self.settings.multigrid_from {
+                let pos: Vec<DVec3> = bodies.iter().map(|&b| s.bodies[b].centre).collect();
+                let mg = Multigrid::new(&k, &pos);
+                mg_pcg(&k, &mg, &f, &mut q, self.settings.tolerance, 2000)
+            } else {
+                pcg(&k, &f, &mut q, self.settings.tolerance, 50 * 6 * n + 1000)
+            };
             *iterations += stats.iterations;
             // Ground contacts pulled or tipped beyond their edge let go;
             // failing that, those beyond their friction slide.

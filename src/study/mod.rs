@@ -2,3 +2,4 @@
 
 pub mod b_study;
 pub mod loadmap;
+pub mod synthetic;
