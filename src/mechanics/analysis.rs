@@ -204,8 +204,11 @@ fn worst_lever(offsets: impl Iterator<Item = DVec3>, g: DVec3) -> DVec3 {
 #[derive(Clone, Debug)]
 struct Cached {
     q: Vec<Vec6>,
+    /// Global link indices, valid only in the step that solved it.
     released: Vec<usize>,
     sliding: Vec<usize>,
+    /// Link results in the component's link order (empty until evaluated).
+    results: Vec<LinkResult>,
 }
 
 /// Analyses structures, optionally reusing work between consecutive calls
@@ -376,44 +379,54 @@ impl Analyzer {
                     r
                 }
             };
-            let Some(sol) = sol else {
+            let Some(mut sol) = sol else {
                 any_unsupported = true;
                 out.unsupported.extend(bodies.iter().copied());
                 continue;
             };
-            if self.incremental {
-                for (k, &b) in bodies.iter().enumerate() {
-                    self.warm.insert(s.bodies[b].module, sol.q[k]);
+            if sol.results.len() != links.len() {
+                // Freshly solved: evaluate every link once and keep the
+                // results (in the component's link order) for reuse.
+                if self.incremental {
+                    for (k, &b) in bodies.iter().enumerate() {
+                        self.warm.insert(s.bodies[b].module, sol.q[k]);
+                    }
                 }
+                for (k, &b) in bodies.iter().enumerate() {
+                    local[b] = k as u32;
+                }
+                let mut results = Vec::with_capacity(links.len());
+                for &li in links {
+                    let l = &s.links[li];
+                    results.push(if sol.released.contains(&li) {
+                        LinkResult {
+                            released: true,
+                            ..Default::default()
+                        }
+                    } else {
+                        let sliding = sol.sliding.contains(&li);
+                        let (load, force, moment) = self.link_forces(s, l, &sol.q, &local, sliding);
+                        let (u, m) = utilisation(&load, self.capacity(l));
+                        LinkResult {
+                            load,
+                            utilisation: u,
+                            mode: Some(m),
+                            released: false,
+                            sliding,
+                            force: force.to_array(),
+                            moment: moment.to_array(),
+                        }
+                    });
+                }
+                for &b in bodies {
+                    local[b] = u32::MAX;
+                }
+                sol.results = results;
+                sol.released.clear();
+                sol.sliding.clear();
             }
-            for (k, &b) in bodies.iter().enumerate() {
-                local[b] = k as u32;
-            }
-            for &li in links {
-                let l = &s.links[li];
-                let released = sol.released.contains(&li);
-                out.links[li] = if released {
-                    LinkResult {
-                        released: true,
-                        ..Default::default()
-                    }
-                } else {
-                    let sliding = sol.sliding.contains(&li);
-                    let (load, force, moment) = self.link_forces(s, l, &sol.q, &local, sliding);
-                    let (u, m) = utilisation(&load, self.capacity(l));
-                    LinkResult {
-                        load,
-                        utilisation: u,
-                        mode: Some(m),
-                        released: false,
-                        sliding,
-                        force: force.to_array(),
-                        moment: moment.to_array(),
-                    }
-                };
-            }
-            for &b in bodies {
-                local[b] = u32::MAX;
+            for (k, &li) in links.iter().enumerate() {
+                out.links[li] = sol.results[k];
             }
             if self.incremental {
                 new_cache.insert(sig, sol);
@@ -683,6 +696,7 @@ impl Analyzer {
                     q,
                     released,
                     sliding,
+                    results: Vec::new(),
                 });
             }
         }
@@ -690,6 +704,7 @@ impl Analyzer {
             q,
             released,
             sliding,
+            results: Vec::new(),
         })
     }
 }
