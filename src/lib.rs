@@ -16,8 +16,10 @@ pub mod certify;
 pub mod error;
 pub mod geometry;
 pub mod lattice;
+pub mod mechanics;
 pub mod render;
 pub mod scenario;
 pub mod schedule;
+pub mod study;
 
 pub use error::InputError;

@@ -48,6 +48,10 @@ struct ReportArgs {
     /// Run the lattice checks only (occupancy, pivots, connectivity).
     #[arg(long)]
     lattice_only: bool,
+    /// Physical model (TOML, see models/) for the gravity and connector-load
+    /// check; overrides the schedule's own `model`.
+    #[arg(long, value_name = "FILE")]
+    model: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -76,6 +80,47 @@ enum Command {
     },
     /// List the generators (algorithms) scenarios can name.
     Algorithms,
+    /// Branch-length study: check every step of a shape family for a range
+    /// of b; table on stdout, plot of utilisation and minimum pressure.
+    BStudy {
+        /// Shape family (see `study::b_study::FAMILIES`).
+        #[arg(long, default_value = "branch")]
+        family: String,
+        /// Physical model (TOML).
+        #[arg(long, value_name = "FILE", default_value = "models/catom-3.6mm.toml")]
+        model: PathBuf,
+        /// Smallest branch length.
+        #[arg(long, default_value_t = 1)]
+        b_min: usize,
+        /// Largest branch length.
+        #[arg(long, default_value_t = 10)]
+        b_max: usize,
+        /// Override the model's connector pressure (kPa).
+        #[arg(long)]
+        pressure: Option<f64>,
+        /// Override the model's bending criterion (elastic | rigid-hinge).
+        #[arg(long)]
+        bending: Option<reconfcheck::mechanics::Bending>,
+        /// Write the plot (PNG, or SVG by extension).
+        #[arg(long, value_name = "FILE")]
+        plot: Option<PathBuf>,
+        /// Write the study as JSON.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
+    },
+    /// Draw the connector load map of a schedule's configuration at a step.
+    Loadmap {
+        schedule: PathBuf,
+        /// Step (1-based; steps + 1 is the final configuration).
+        #[arg(long, default_value_t = 1)]
+        step: usize,
+        /// Physical model (TOML); default: the schedule's own.
+        #[arg(long, value_name = "FILE")]
+        model: Option<PathBuf>,
+        /// Output picture (PNG, or SVG by extension).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Seed 003 §V-B1: active subtraction on random configurations of
     /// several densities; prints a table and draws a box plot.
     DensityStudy {
@@ -214,6 +259,71 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             eprintln!("wrote {}", output.display());
             Ok(0)
         }
+        Command::BStudy {
+            family,
+            model,
+            b_min,
+            b_max,
+            pressure,
+            bending,
+            plot,
+            json,
+        } => {
+            use reconfcheck::study::b_study;
+            let mut m = reconfcheck::mechanics::Model::load(&model)?;
+            if pressure.is_some() || bending.is_some() {
+                m = m.with_connector(
+                    pressure.map_or(m.connector.pressure, |k| k * 1e3),
+                    bending.unwrap_or(m.connector.bending),
+                );
+            }
+            if b_min == 0 || b_min > b_max {
+                return Err(InputError::new(format!("bad range of b: {b_min}..={b_max}")).into());
+            }
+            let generate = b_study::family(&family, m.spacing * 1e3)?;
+            let lengths: Vec<usize> = (b_min..=b_max).collect();
+            let st = b_study::b_study(&family, &m, &lengths, generate)?;
+            print!("{}", st.table());
+            if let Some(p) = &plot {
+                st.plot(p).map_err(Failure::Output)?;
+                eprintln!("wrote {}", p.display());
+            }
+            if let Some(p) = &json {
+                write(
+                    p,
+                    &serde_json::to_string_pretty(&st).expect("study serialises"),
+                )?;
+            }
+            Ok(0)
+        }
+        Command::Loadmap {
+            schedule,
+            step,
+            model,
+            output,
+        } => {
+            let s = Schedule::load(&schedule)?;
+            let opts = Options {
+                model,
+                base_dir: schedule.parent().map(Path::to_path_buf),
+                ..Default::default()
+            };
+            let path = certify::model_path(&s, &opts).ok_or_else(|| {
+                InputError::new("no model: pass --model FILE or name one in the schedule")
+                    .in_file(&schedule)
+            })?;
+            let m = reconfcheck::mechanics::Model::load(&path)?;
+            let summary = reconfcheck::study::loadmap::render_step(&s, &m, step, &output).map_err(
+                |e| match e {
+                    reconfcheck::study::loadmap::Error::Input(e) => {
+                        Failure::Input(e.in_file(&schedule))
+                    }
+                    reconfcheck::study::loadmap::Error::Output(e) => Failure::Output(e),
+                },
+            )?;
+            println!("{summary}");
+            Ok(0)
+        }
         Command::Algorithms => {
             for g in algorithms::registry() {
                 println!("{:<20} {}", g.name(), g.about());
@@ -230,6 +340,8 @@ fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<
         exact: args.exact,
         epsilon: args.epsilon,
         lattice_only: args.lattice_only,
+        model: args.model.clone(),
+        base_dir: origin.parent().map(Path::to_path_buf),
     };
     let report: Report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
     let json = report.to_json();

@@ -5,6 +5,7 @@
 //! on the lattice and schedule layers only, never on certification.
 
 pub mod active_subtraction;
+pub mod branch;
 pub mod random_walk;
 pub mod schedule_file;
 
@@ -28,6 +29,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &schedule_file::ScheduleFile,
         &random_walk::RandomWalk,
         &active_subtraction::ActiveSubtraction,
+        &branch::Branch,
     ]
 }
 

@@ -6,17 +6,20 @@
 
 pub mod collision_check;
 pub mod lattice_check;
+pub mod load_check;
 pub mod report;
 pub mod world;
 
 pub use collision_check::CollisionCheck;
 pub use lattice_check::LatticeCheck;
+pub use load_check::LoadCheck;
 pub use report::{Report, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;
 use crate::schedule::Schedule;
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
 /// Certification options.
 #[derive(Clone, Debug)]
@@ -31,6 +34,12 @@ pub struct Options {
     pub epsilon: f64,
     /// Run the lattice checks only (no geometry, no mechanics).
     pub lattice_only: bool,
+    /// Physical model file for the mechanics check; overrides the
+    /// schedule's own `model`.
+    pub model: Option<PathBuf>,
+    /// Directory the schedule's relative `model` path is resolved against
+    /// (the schedule file's directory).
+    pub base_dir: Option<PathBuf>,
 }
 
 impl Default for Options {
@@ -41,6 +50,8 @@ impl Default for Options {
             exact: false,
             epsilon: crate::geometry::EPSILON,
             lattice_only: false,
+            model: None,
+            base_dir: None,
         }
     }
 }
@@ -72,7 +83,8 @@ pub trait StepCheck: Send + Sync {
 }
 
 /// The checks that apply to a schedule: the lattice checks always, the
-/// collision check where the lattice has a body model.
+/// collision check where the lattice has a body model, the mechanics check
+/// where a physical model is given (by the user or the schedule).
 pub fn checks_for(
     schedule: &Schedule,
     opts: &Options,
@@ -88,14 +100,41 @@ pub fn checks_for(
             exact: opts.exact,
         }));
     }
+    if let Some(path) = model_path(schedule, opts) {
+        let model = crate::mechanics::Model::load(&path)?;
+        checks.push(Box::new(LoadCheck::new(
+            &model,
+            schedule.spacing.metres(),
+            true,
+        )));
+    }
     Ok(checks)
 }
+
+/// The model file the mechanics check uses: the user's, else the
+/// schedule's (relative to its directory), else none.
+pub fn model_path(schedule: &Schedule, opts: &Options) -> Option<PathBuf> {
+    opts.model.clone().or_else(|| {
+        schedule.model.as_ref().map(|m| match &opts.base_dir {
+            Some(dir) => dir.join(m),
+            None => PathBuf::from(m),
+        })
+    })
+}
+
+/// What the report's check list says when no model was given.
+pub const MECHANICS_NOT_RUN: &str =
+    "mechanics: not run (no model: pass --model FILE or name one in the schedule)";
 
 /// Certifies `schedule` with every check that applies to it.
 pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError> {
     let checks = checks_for(schedule, opts)?;
     let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
-    certify_with(schedule, opts, &refs)
+    let mut report = certify_with(schedule, opts, &refs)?;
+    if !opts.lattice_only && !checks.iter().any(|c| c.name() == load_check::NAME) {
+        report.checks.push(MECHANICS_NOT_RUN.to_string());
+    }
+    Ok(report)
 }
 
 /// Certifies `schedule` with the given checks. Input errors (not a schedule

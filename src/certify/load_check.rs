@@ -1,0 +1,347 @@
+//! Gravity stability and connector loads (SPEC §4.5) of every intermediate
+//! structure: the static modules of the step plus its movers hanging on
+//! their pivots, through [`crate::mechanics`].
+//!
+//! Work is reused between consecutive steps: the analyser keeps the
+//! previous step's solution of every connected component, re-solves only
+//! the components the step changed, and warm-starts those from the
+//! displacements of their modules in the previous step.
+
+use super::report::{Violation, ViolationKind};
+use super::{StepCheck, StepContext, StepOutcome, World};
+use crate::lattice::config::ModuleId;
+use crate::mechanics::analysis::{Analysis, Critical, Verdict};
+use crate::mechanics::structure::{End, MoverSpec, SceneRef, Structure};
+use crate::mechanics::{Analyzer, Model};
+use rustc_hash::FxHashSet;
+use std::sync::Mutex;
+
+/// Name of the check in reports.
+pub const NAME: &str = "mechanics";
+
+/// The mechanical check of every step.
+pub struct LoadCheck {
+    analyzer: Mutex<Analyzer>,
+}
+
+impl LoadCheck {
+    /// A check with `model` at the schedule's lattice spacing `spacing` (m).
+    pub fn new(model: &Model, spacing: f64, incremental: bool) -> LoadCheck {
+        LoadCheck {
+            analyzer: Mutex::new(Analyzer::new(model.at_spacing(spacing), incremental)),
+        }
+    }
+
+    fn analyse(
+        &self,
+        world: &World,
+        exclude: &FxHashSet<ModuleId>,
+        movers: &[MoverSpec],
+    ) -> (Structure, Analysis) {
+        let scene = SceneRef {
+            lattice: world.lattice,
+            ground: world.ground,
+            config: &world.config,
+            fixed: &world.fixed,
+            exclude,
+            latched: &|a, b| world.latched(a, b),
+        };
+        let s = Structure::build(&scene, movers);
+        let a = self.analyzer.lock().expect("analyser lock").analyse(&s);
+        (s, a)
+    }
+}
+
+/// Describes the critical element of an analysis as a violation detail.
+pub fn critical_violation(
+    kind: ViolationKind,
+    step: usize,
+    what: &str,
+    s: &Structure,
+    a: &Analysis,
+) -> Violation {
+    let overloaded = a
+        .links
+        .iter()
+        .filter(|r| r.utilisation > 1.0 + 1e-9)
+        .count()
+        + a.pivots
+            .iter()
+            .filter(|r| r.utilisation > 1.0 + 1e-9)
+            .count();
+    let mut v = match a.critical {
+        Some(Critical::Link(i)) => {
+            let l = &s.links[i];
+            let r = &a.links[i];
+            let mut modules = vec![s.bodies[l.a].module];
+            let mut cells = vec![s.bodies[l.a].cell];
+            match l.b {
+                End::Body(b) => {
+                    modules.push(s.bodies[b].module);
+                    cells.push(s.bodies[b].cell);
+                }
+                End::Ground(c) => cells.push(c),
+            }
+            Violation::new(
+                kind,
+                step,
+                format!(
+                    "{what}: most loaded is the {} at utilisation {:.3} ({})",
+                    s.describe(l),
+                    r.utilisation,
+                    r.mode.map(|m| m.name()).unwrap_or("-")
+                ),
+            )
+            .modules(modules)
+            .cells(cells)
+            .detail("connector", s.describe(l))
+            .detail("utilisation", r.utilisation)
+            .detail("mode", r.mode.map(|m| m.name()))
+            .detail("load", r.load)
+        }
+        Some(Critical::Pivot(i)) => {
+            let p = &a.pivots[i];
+            let h = &s.hanging[p.hanging];
+            let pivot = &s.bodies[h.pivot];
+            Violation::new(
+                kind,
+                step,
+                format!(
+                    "{what}: mover {} on its pivot {} at utilisation {:.3} ({}, s = {:.2})",
+                    h.mover,
+                    pivot.module,
+                    p.utilisation,
+                    p.mode.name(),
+                    p.s
+                ),
+            )
+            .modules([h.mover, pivot.module])
+            .cells([pivot.cell])
+            .detail(
+                "connector",
+                format!("pivot connector {}–{}", h.mover, pivot.module),
+            )
+            .detail("utilisation", p.utilisation)
+            .detail("mode", p.mode.name())
+            .detail("s", p.s)
+            .detail("load", p.load)
+        }
+        None => Violation::new(kind, step, what.to_string()),
+    };
+    v = v.detail("overloaded_connectors", overloaded);
+    v
+}
+
+fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
+    out.metrics
+        .insert("max_utilisation".into(), a.max_utilisation);
+    match a.verdict() {
+        Verdict::Stable => {}
+        Verdict::Overloaded => out.violations.push(critical_violation(
+            ViolationKind::Overload,
+            step,
+            "connector overloaded",
+            s,
+            a,
+        )),
+        Verdict::NoEquilibrium => {
+            let loose: Vec<ModuleId> = a.unsupported.iter().map(|&b| s.bodies[b].module).collect();
+            let what = if loose.is_empty() {
+                "no static equilibrium: a ground contact slides".to_string()
+            } else {
+                format!(
+                    "no static equilibrium: {} module(s) tip over or are unsupported",
+                    loose.len()
+                )
+            };
+            let mut v = critical_violation(ViolationKind::Unstable, step, &what, s, a);
+            v.modules.extend(loose.iter().take(50));
+            out.violations
+                .push(v.detail("unsupported_modules", loose.len()));
+        }
+    }
+}
+
+impl StepCheck for LoadCheck {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome) {
+        let movers: Vec<MoverSpec> = ctx
+            .plan
+            .moves
+            .iter()
+            .filter(|m| m.pivot_resolved)
+            .map(|m| (m.module, m.pivot, m.motion.clone()))
+            .collect();
+        let (s, a) = self.analyse(ctx.world, &ctx.plan.moving, &movers);
+        report(ctx.plan.step, &s, &a, out);
+    }
+
+    fn check_final(&self, world: &World, step: usize, out: &mut StepOutcome) {
+        let (s, a) = self.analyse(world, &FxHashSet::default(), &[]);
+        report(step, &s, &a, out);
+    }
+}
+
+/// Replays `schedule` and analyses every intermediate structure (and the
+/// final one, reported as step `steps + 1`), handing each to `visit` with
+/// the step's lattice-check findings. Used by the b-study, the load map and
+/// the benchmarks; `incremental` selects reuse between steps.
+pub fn replay(
+    schedule: &crate::schedule::Schedule,
+    model: &Model,
+    incremental: bool,
+    mut visit: impl FnMut(usize, &Structure, &Analysis, &StepOutcome),
+) -> Result<(), crate::error::InputError> {
+    let check = LoadCheck::new(model, schedule.spacing.metres(), incremental);
+    let mut world = World::initial(schedule)?;
+    for (k, step) in schedule.steps.iter().enumerate() {
+        let plan = world.resolve(k + 1, step)?;
+        let mut out = StepOutcome {
+            violations: plan.violations.clone(),
+            ..Default::default()
+        };
+        let ctx = StepContext {
+            world: &world,
+            plan: &plan,
+        };
+        super::LatticeCheck.check(&ctx, &mut out);
+        let movers: Vec<MoverSpec> = plan
+            .moves
+            .iter()
+            .filter(|m| m.pivot_resolved)
+            .map(|m| (m.module, m.pivot, m.motion.clone()))
+            .collect();
+        let (s, a) = check.analyse(&world, &plan.moving, &movers);
+        visit(k + 1, &s, &a, &out);
+        let clashes = world.apply(&plan);
+        if !clashes.is_empty() {
+            return Err(crate::error::InputError::new(format!(
+                "step {}: {}",
+                k + 1,
+                clashes[0].message
+            )));
+        }
+    }
+    let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
+    visit(schedule.steps.len() + 1, &s, &a, &StepOutcome::default());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::certify::{MECHANICS_NOT_RUN, Options, certify};
+    use crate::lattice::{Cell, FccLattice, Lattice, LatticeKind, Route};
+    use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
+    use std::path::PathBuf;
+
+    fn models() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models")
+    }
+
+    /// A fixed root, a horizontal branch of `n` modules, and a free agent
+    /// above the tip that rolls over it to extend the branch.
+    fn branch_schedule(n: i32) -> Schedule {
+        let l = FccLattice;
+        let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+        for i in 0..=n {
+            s.modules.push(ModuleSpec {
+                id: i as u32 + 1,
+                cell: Cell::new(i, 0, 0),
+                fixed: i == 0,
+            });
+        }
+        let tip = Cell::new(n, 0, 0);
+        let from = l.neighbour(tip, 4);
+        let agent = n as u32 + 2;
+        s.modules.push(ModuleSpec {
+            id: agent,
+            cell: from,
+            fixed: false,
+        });
+        s.steps.push(Step {
+            events: vec![Event::Rotate {
+                module: agent,
+                pivot: n as u32 + 1,
+                from,
+                to: l.neighbour(tip, 0),
+                route: Route::Octagonal,
+            }],
+        });
+        s
+    }
+
+    fn opts(model: Option<&str>) -> Options {
+        Options {
+            model: model.map(|m| models().join(m)),
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_short_branch_extended_by_an_agent_is_certified_with_its_utilisation() {
+        let r = certify(&branch_schedule(3), &opts(Some("catom-3.6mm.toml"))).unwrap();
+        assert!(r.checks.contains(&NAME.to_string()));
+        assert!(r.certified, "{}", r.summary());
+        // Step 1: three modules plus the agent hanging beyond the tip:
+        // (n+1)²/2 · W·d against p·L³/2 (rigid hinge).
+        let m = Model::default_catom();
+        let expected = crate::mechanics::closed_form::cantilever_utilisation(&m, 3, true);
+        let got = r.per_step[0].metrics["max_utilisation"];
+        assert!(
+            (got - expected).abs() < 1e-6 * expected,
+            "{got} vs {expected}"
+        );
+    }
+
+    #[test]
+    fn an_agent_overloading_the_root_of_a_branch_is_reported_with_the_connector() {
+        // 10 kPa, elastic bending: one module holds (1 ≤ pL³/(3mgd) ≈ 1.55),
+        // one module plus the agent does not (4 > 1.55).
+        let r = certify(&branch_schedule(1), &opts(Some("catom-3.6mm-10kpa.toml"))).unwrap();
+        assert!(!r.certified);
+        let v: Vec<_> = r
+            .violations
+            .iter()
+            .filter(|v| v.kind == ViolationKind::Overload)
+            .collect();
+        assert_eq!(v.len(), 2, "{}", r.summary()); // the step and the final structure
+        assert_eq!(v[0].step, 1);
+        assert_eq!(
+            v[0].modules,
+            vec![1, 2],
+            "the root connector: {}",
+            v[0].message
+        );
+        assert!(v[0].detail["utilisation"].as_f64().unwrap() > 1.0);
+    }
+
+    #[test]
+    fn without_a_model_the_report_says_the_mechanics_did_not_run() {
+        let r = certify(&branch_schedule(1), &opts(None)).unwrap();
+        assert!(r.checks.iter().any(|c| c == MECHANICS_NOT_RUN));
+        assert!(r.per_step[0].metrics.get("max_utilisation").is_none());
+    }
+
+    #[test]
+    fn the_schedule_names_its_model_relative_to_its_own_file() {
+        let mut s = branch_schedule(1);
+        s.model = Some("catom-3.6mm-10kpa.toml".into());
+        let o = Options {
+            base_dir: Some(models()),
+            ..Default::default()
+        };
+        let r = certify(&s, &o).unwrap();
+        assert!(
+            r.violations
+                .iter()
+                .any(|v| v.kind == ViolationKind::Overload)
+        );
+        // A missing model file is unusable input, not a silent pass.
+        s.model = Some("no-such-model.toml".into());
+        assert!(certify(&s, &o).is_err());
+    }
+}

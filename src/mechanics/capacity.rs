@@ -1,0 +1,210 @@
+//! Connector capacity: when does an electrostatic connector square of side
+//! `L` and adhesion pressure `p` let go? (SPEC §7, derived in
+//! `docs/mechanics.md`.)
+//!
+//! Loads are in the connector's frame: `N` axial (tension > 0), `V` shear
+//! (magnitude), `T` torsion about the normal, `M_u`, `M_v` bending about the
+//! square's edge axes. The contact takes unlimited compression; the
+//! adhesion acts as a pressure `p` pressing the faces together.
+//!
+//! * Axial + bending, rigid hinge (lower-bound theorem: tension `p`
+//!   everywhere plus a compressive resultant `C = pL² − N` anywhere in the
+//!   square): `max(|M_u|, |M_v|) ≤ (pL² − N)·L/2`.
+//! * Axial + bending, elastic (linear stress, first corner at `p`):
+//!   `N + 6(|M_u| + |M_v|)/L ≤ pL²`.
+//! * Shear + torsion share the friction of the clamping force `C`:
+//!   `|V| + |T|/(0.383·L) ≤ μ·(pL² − N)` (linear interaction, inside the
+//!   exact convex friction limit surface, hence safe).
+//!
+//! Each criterion reads `demand ≤ capacity` with compression moved to the
+//! capacity side; the utilisation is the largest ratio, so it stays defined
+//! for a ground contact without adhesion (`p = 0`): there it is 1 exactly
+//! when the resultant reaches the edge of the contact (tipping) or the
+//! friction cone (sliding).
+
+use super::model::{Bending, Capacity};
+
+/// Torsional friction lever of a uniformly pressed square, as a fraction of
+/// `L` (SPEC §7: `∫|r| dA / A` for the unit square ≈ 0.3826).
+pub const TORSION_LEVER: f64 = 0.383;
+
+/// A connector's load in its own frame (N, N·m).
+#[derive(Copy, Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ConnectorLoad {
+    /// Axial force, tension positive.
+    pub axial: f64,
+    /// Shear force magnitude.
+    pub shear: f64,
+    /// Torsion about the normal.
+    pub torsion: f64,
+    /// Bending moment about the square's first edge axis.
+    pub moment_u: f64,
+    /// Bending moment about the square's second edge axis.
+    pub moment_v: f64,
+}
+
+/// Which criterion governs a utilisation.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Tension and bending: the square peels or tips open.
+    Bending,
+    /// Shear and torsion: the square slides.
+    Friction,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Bending => "bending",
+            Mode::Friction => "friction",
+        }
+    }
+}
+
+impl ConnectorLoad {
+    /// The load scaled by `k` (superposition).
+    pub fn scaled(self, k: f64) -> ConnectorLoad {
+        ConnectorLoad {
+            axial: self.axial * k,
+            shear: self.shear * k,
+            torsion: self.torsion * k,
+            moment_u: self.moment_u * k,
+            moment_v: self.moment_v * k,
+        }
+    }
+}
+
+/// Utilisation (load / capacity, failure at 1) and its governing mode.
+pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
+    let l = cap.side;
+    let tension = load.axial.max(0.0);
+    let compression = (-load.axial).max(0.0);
+    let clamp = cap.tension() + compression;
+    let bending_demand = tension
+        + match cap.bending {
+            Bending::RigidHinge => 2.0 * load.moment_u.abs().max(load.moment_v.abs()) / l,
+            Bending::Elastic => 6.0 * (load.moment_u.abs() + load.moment_v.abs()) / l,
+        };
+    let friction_demand =
+        tension + (load.shear.abs() + load.torsion.abs() / (TORSION_LEVER * l)) / cap.friction;
+    let ratio = |demand: f64| {
+        if demand <= 0.0 {
+            0.0
+        } else if clamp <= 0.0 {
+            f64::INFINITY
+        } else {
+            demand / clamp
+        }
+    };
+    let b = ratio(bending_demand);
+    let f = ratio(friction_demand);
+    if b >= f {
+        (b, Mode::Bending)
+    } else {
+        (f, Mode::Friction)
+    }
+}
+
+/// The smallest adhesion pressure (Pa) at which `load` is within capacity
+/// (utilisation ≤ 1), other parameters unchanged: every criterion is
+/// `demand ≤ p·L² + compression`, so it is solved in closed form.
+pub fn required_pressure(load: &ConnectorLoad, cap: &Capacity) -> f64 {
+    let mut lo = Capacity {
+        pressure: 0.0,
+        ..*cap
+    };
+    let (u0, _) = utilisation(load, &lo);
+    if u0 <= 1.0 {
+        return 0.0;
+    }
+    // demand = u(p)·(pL² + compression) is independent of p.
+    let compression = (-load.axial).max(0.0);
+    lo.pressure = 1.0;
+    let (u1, _) = utilisation(load, &lo);
+    let demand = u1 * (lo.tension() + compression);
+    (demand - compression) / (cap.side * cap.side)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cap(bending: Bending) -> Capacity {
+        Capacity {
+            pressure: 100e3,
+            side: 1e-3,
+            friction: 0.5,
+            bending,
+        }
+    }
+
+    #[test]
+    fn pure_tension_fails_at_p_l_squared() {
+        for b in [Bending::Elastic, Bending::RigidHinge] {
+            let c = cap(b);
+            let load = ConnectorLoad {
+                axial: c.tension(),
+                ..Default::default()
+            };
+            assert!((utilisation(&load, &c).0 - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn rigid_hinge_moment_limit_is_p_l_cubed_over_two() {
+        let c = cap(Bending::RigidHinge);
+        let m = c.pressure * c.side.powi(3) / 2.0;
+        let load = ConnectorLoad {
+            moment_u: m,
+            ..Default::default()
+        };
+        assert!((utilisation(&load, &c).0 - 1.0).abs() < 1e-12);
+        // Elastic is three times stricter for the same moment.
+        assert!((utilisation(&load, &cap(Bending::Elastic)).0 - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn compression_raises_moment_and_friction_capacity() {
+        let c = Capacity {
+            pressure: 0.0,
+            ..cap(Bending::RigidHinge)
+        };
+        // Without adhesion a contact under 1 N compression tips when the
+        // resultant reaches the edge: M = N·L/2.
+        let edge = ConnectorLoad {
+            axial: -1.0,
+            moment_v: 0.5 * c.side,
+            ..Default::default()
+        };
+        assert!((utilisation(&edge, &c).0 - 1.0).abs() < 1e-12);
+        // … and slides when the shear reaches μN.
+        let slide = ConnectorLoad {
+            axial: -1.0,
+            shear: 0.5,
+            ..Default::default()
+        };
+        assert!((utilisation(&slide, &c).0 - 1.0).abs() < 1e-12);
+        assert_eq!(utilisation(&slide, &c).1, Mode::Friction);
+        let lifted = ConnectorLoad {
+            axial: 1e-9,
+            ..Default::default()
+        };
+        assert!(utilisation(&lifted, &c).0.is_infinite());
+    }
+
+    #[test]
+    fn required_pressure_puts_the_load_exactly_at_capacity() {
+        let c = cap(Bending::Elastic);
+        let load = ConnectorLoad {
+            axial: -0.02,
+            shear: 0.01,
+            torsion: 1e-6,
+            moment_u: 3e-5,
+            moment_v: 1e-5,
+        };
+        let p = required_pressure(&load, &c);
+        let at = Capacity { pressure: p, ..c };
+        assert!((utilisation(&load, &at).0 - 1.0).abs() < 1e-9, "{p}");
+    }
+}

@@ -1,0 +1,412 @@
+//! Validation of the static analysis against closed forms and first
+//! principles: each test fails if the physics is wrong.
+
+use super::analysis::{Analyzer, Verdict};
+use super::model::{Bending, Model};
+use super::structure::{MoverSpec, SceneRef, Structure};
+use crate::lattice::config::{Ground, ModuleId};
+use crate::lattice::{Cell, Configuration, FccLattice, Lattice, Motion, Route, SquareLattice};
+use glam::DVec3;
+use rustc_hash::FxHashSet;
+
+/// A structure from cells (ids 1, 2, … in order); `fixed` lists indices.
+pub(crate) fn structure(
+    lattice: &dyn Lattice,
+    ground: Option<Ground>,
+    cells: &[Cell],
+    fixed: &[usize],
+    movers: &[MoverSpec],
+) -> Structure {
+    structure_without(lattice, ground, cells, fixed, movers, &[])
+}
+
+/// As [`structure`], with the modules `absent` left out of the scene.
+pub(crate) fn structure_without(
+    lattice: &dyn Lattice,
+    ground: Option<Ground>,
+    cells: &[Cell],
+    fixed: &[usize],
+    movers: &[MoverSpec],
+    absent: &[ModuleId],
+) -> Structure {
+    let mut config = Configuration::new();
+    for (i, c) in cells.iter().enumerate() {
+        config.insert(i as ModuleId + 1, *c).unwrap();
+    }
+    let fixed: FxHashSet<ModuleId> = fixed.iter().map(|&i| i as ModuleId + 1).collect();
+    let exclude: FxHashSet<ModuleId> = movers
+        .iter()
+        .map(|m| m.0)
+        .chain(absent.iter().copied())
+        .collect();
+    let scene = SceneRef {
+        lattice,
+        ground,
+        config: &config,
+        fixed: &fixed,
+        exclude: &exclude,
+        latched: &|_, _| true,
+    };
+    Structure::build(&scene, movers)
+}
+
+fn tight(model: Model) -> Analyzer {
+    let mut a = Analyzer::new(model, false);
+    a.settings.tolerance = 1e-13;
+    a
+}
+
+/// Index of the link between the modules with ids `a` and `b`.
+fn link_between(s: &Structure, a: ModuleId, b: ModuleId) -> usize {
+    let (ia, ib) = (s.body_of(a).unwrap(), s.body_of(b).unwrap());
+    s.links
+        .iter()
+        .position(|l| {
+            (l.a == ia && l.b == super::structure::End::Body(ib))
+                || (l.a == ib && l.b == super::structure::End::Body(ia))
+        })
+        .unwrap()
+}
+
+fn bending(l: &super::capacity::ConnectorLoad) -> f64 {
+    l.moment_u.hypot(l.moment_v)
+}
+
+#[test]
+fn horizontal_cantilever_root_moment_matches_closed_form() {
+    let model = Model::default_catom();
+    let (w, d) = (model.weight(), model.spacing);
+    let n = 6;
+    let cells: Vec<Cell> = (0..=n).map(|i| Cell::new(i, 0, 0)).collect();
+    let s = structure(&FccLattice, None, &cells, &[0], &[]);
+    let a = tight(model.clone()).analyse(&s);
+    // Every connector k (between modules k and k+1, 0 = fixed root)
+    // carries the weight and moment of everything beyond it.
+    for k in 0..n {
+        let li = link_between(&s, k as u32 + 1, k as u32 + 2);
+        let load = a.links[li].load;
+        let beyond = (n - k) as f64;
+        let moment: f64 = (1..=(n - k)).map(|j| j as f64 - 0.5).sum::<f64>() * w * d;
+        assert!(
+            (bending(&load) - moment).abs() <= 1e-6 * moment,
+            "k={k}: {} vs {moment}",
+            bending(&load)
+        );
+        assert!((load.shear - beyond * w).abs() <= 1e-6 * beyond * w);
+        assert!(load.axial.abs() <= 1e-6 * w && load.torsion.abs() <= 1e-6 * w * d);
+    }
+    // The root is the critical connector, at the closed-form utilisation.
+    let root = link_between(&s, 1, 2);
+    assert_eq!(a.critical, Some(super::analysis::Critical::Link(root)));
+    let expected = super::closed_form::cantilever_utilisation(&model, n as usize, false);
+    assert!((a.max_utilisation - expected).abs() <= 1e-6 * expected);
+    assert_eq!(a.verdict(), Verdict::Stable);
+}
+
+#[test]
+fn loads_of_a_determinate_cantilever_do_not_depend_on_stiffness() {
+    let cells: Vec<Cell> = (0..5).map(|i| Cell::new(i, 0, 0)).collect();
+    let s = structure(&FccLattice, None, &cells, &[0], &[]);
+    let mut soft = Model::default_catom();
+    soft.poisson = 0.0;
+    let mut hard = Model::default_catom();
+    hard.poisson = 0.49;
+    let (a, b) = (tight(soft).analyse(&s), tight(hard).analyse(&s));
+    for (x, y) in a.links.iter().zip(&b.links) {
+        assert!((x.utilisation - y.utilisation).abs() < 1e-7);
+    }
+}
+
+#[test]
+fn clamped_beam_on_two_supports_matches_the_compatibility_closed_form() {
+    // Fixed supports at both ends, n free modules between: shear n/2 at
+    // each end by symmetry; connector rotations (M_k / k_b, equal springs)
+    // must add up to zero between two clamps, which fixes the end moment:
+    // M_k = M_0 + W·d·(n·k − k²)/2 (statics of the left part), Σ_k M_k = 0.
+    let model = Model::default_catom();
+    let (w, d) = (model.weight(), model.spacing);
+    let n = 7;
+    let cells: Vec<Cell> = (0..=n + 1).map(|i| Cell::new(i, 0, 0)).collect();
+    let s = structure(&FccLattice, None, &cells, &[0, n as usize + 1], &[]);
+    let a = tight(model).analyse(&s);
+    let statics: Vec<f64> = (0..=n)
+        .map(|k| (n * k) as f64 / 2.0 - (k * k) as f64 / 2.0)
+        .collect();
+    let m0 = -statics.iter().sum::<f64>() / (n + 1) as f64;
+    let scale = w * d * n as f64;
+    for k in 0..=n {
+        let li = link_between(&s, k as u32 + 1, k as u32 + 2);
+        let expected = (m0 + statics[k as usize]).abs() * w * d;
+        let got = bending(&a.links[li].load);
+        assert!(
+            (got - expected).abs() < 1e-6 * scale,
+            "k={k}: {got} vs {expected}"
+        );
+    }
+    let left = a.links[link_between(&s, 1, 2)].load.shear;
+    assert!((left - n as f64 / 2.0 * w).abs() < 1e-6 * w);
+}
+
+#[test]
+fn reactions_balance_the_total_weight_of_an_indeterminate_block() {
+    // A 3 × 3 × 3 FCC block on the ground, with a mover hanging on its top.
+    let model = Model::default_catom();
+    let mut cells = Vec::new();
+    for z in 0..3 {
+        for x in 0..3 {
+            for y in 0..3 {
+                cells.push(Cell::new(x, y, z));
+            }
+        }
+    }
+    let mover_cell = Cell::new(3, 1, 2);
+    let pivot_cell = Cell::new(2, 1, 2);
+    cells.push(mover_cell);
+    let mover = cells.len() as ModuleId;
+    let pivot = cells.iter().position(|c| *c == pivot_cell).unwrap() as ModuleId + 1;
+    let motion = Motion::Rotate {
+        from: mover_cell,
+        to: FccLattice.neighbour(pivot_cell, 4),
+        pivot: pivot_cell,
+        route: Route::Octagonal,
+    };
+    let s = structure(
+        &FccLattice,
+        Some(Ground { layer: 0 }),
+        &cells,
+        &[],
+        &[(mover, Some(pivot), motion)],
+    );
+    let mut m = model.clone();
+    m.ground.pressure = m.connector.pressure; // latched to the sandbox: no lift-off
+    let a = tight(m).analyse(&s);
+    let mut total = DVec3::ZERO;
+    for (l, r) in s.links.iter().zip(&a.links) {
+        if l.is_ground() {
+            total += DVec3::from_array(r.force);
+        }
+    }
+    let expected = DVec3::new(0.0, 0.0, -(cells.len() as f64) * model.weight());
+    assert!(
+        (total - expected).length() < 1e-6 * expected.length(),
+        "{total} vs {expected}"
+    );
+    assert_eq!(a.pivots.len(), 1);
+}
+
+#[test]
+fn superposition_of_mover_loads_holds() {
+    // On a fixed base (no unilateral contact), loads are linear: the
+    // response to two movers is the sum of the responses to each.
+    let mut cells = vec![Cell::new(0, 0, 0), Cell::new(1, 0, 0)];
+    for x in 0..4 {
+        cells.push(Cell::new(x, 0, 1));
+    }
+    cells.push(Cell::new(0, 0, 2));
+    cells.push(Cell::new(3, 0, 2));
+    let (m1, m2) = (7, 8);
+    let rot = |from: Cell, pivot: Cell| Motion::Rotate {
+        from,
+        to: FccLattice.neighbour(pivot, 2),
+        pivot,
+        route: Route::Octagonal,
+    };
+    let mv1: MoverSpec = (m1, Some(3), rot(cells[6], cells[2]));
+    let mv2: MoverSpec = (m2, Some(6), rot(cells[7], cells[5]));
+    let model = Model::default_catom();
+    let run = |movers: &[MoverSpec], absent: &[ModuleId]| {
+        let s = structure_without(&FccLattice, None, &cells, &[0, 1], movers, absent);
+        tight(model.clone()).analyse(&s)
+    };
+    // The movers are excluded from the static structure in every case.
+    let none = {
+        let s = structure(&FccLattice, None, &cells[..6], &[0, 1], &[]);
+        tight(model.clone()).analyse(&s)
+    };
+    let a = run(&[mv1.clone()], &[m2]);
+    let b = run(&[mv2.clone()], &[m1]);
+    let ab = run(&[mv1, mv2], &[]);
+    let scale = model.weight() * model.spacing;
+    for i in 0..none.links.len() {
+        for k in 0..3 {
+            let sum = a.links[i].force[k] + b.links[i].force[k] - none.links[i].force[k];
+            assert!((ab.links[i].force[k] - sum).abs() < 1e-8 * model.weight());
+            let msum = a.links[i].moment[k] + b.links[i].moment[k] - none.links[i].moment[k];
+            assert!((ab.links[i].moment[k] - msum).abs() < 1e-8 * scale);
+        }
+    }
+    // And the movers do change the loads (the test is not vacuous).
+    let changed = (0..none.links.len())
+        .any(|i| (ab.links[i].moment[1] - none.links[i].moment[1]).abs() > 0.1 * scale);
+    assert!(changed);
+}
+
+fn square_model(ground_kpa: f64) -> Model {
+    let mut m = Model::from_toml(include_str!("../../models/sliding-square.toml")).unwrap();
+    m.ground.pressure = ground_kpa * 1e3;
+    m
+}
+
+#[test]
+fn an_overhang_tips_without_ground_adhesion_and_holds_with_it() {
+    // 2D: a base on the ground, a column, an arm over empty space. The
+    // centre of mass of base + column + arm of length k is at x = k(k+1)/2/(k+2)
+    // (units of d); the base's contact spans x ∈ [−½, ½].
+    let ground = Some(Ground { layer: 0 });
+    let arm = |k: i32| {
+        let mut c = vec![Cell::xy(0, 0), Cell::xy(0, 1)];
+        c.extend((1..=k).map(|x| Cell::xy(x, 1)));
+        c
+    };
+    // k = 1: centre of mass at 1/3 < ½: stands on its own.
+    let short = structure(&SquareLattice, ground, &arm(1), &[], &[]);
+    let a = tight(square_model(0.0)).analyse(&short);
+    assert_eq!(a.verdict(), Verdict::Stable, "{:?}", a.max_utilisation);
+    // The ground contact's utilisation is the resultant's offset over the
+    // half-width: (1/3)/(1/2).
+    let g = short.links.iter().position(|l| l.is_ground()).unwrap();
+    assert!((a.links[g].utilisation - 2.0 / 3.0).abs() < 1e-6);
+    // k = 2: centre of mass at 3/4 > ½: tips over.
+    let long = structure(&SquareLattice, ground, &arm(2), &[], &[]);
+    let b = tight(square_model(0.0)).analyse(&long);
+    assert_eq!(b.verdict(), Verdict::NoEquilibrium);
+    assert_eq!(b.unsupported.len(), 4);
+    // With the ground latched (adhesion), the same overhang holds.
+    let c = tight(square_model(20.0)).analyse(&long);
+    assert_eq!(c.verdict(), Verdict::Stable);
+}
+
+#[test]
+fn a_structure_on_two_feet_tips_when_its_centre_of_mass_leaves_the_base() {
+    // A deck on two ground modules (x = 0 and x = 2) with an arm to the
+    // right. The base spans x ∈ [−½, 2½].
+    let ground = Some(Ground { layer: 0 });
+    let deck = |to: i32| {
+        let mut c = vec![Cell::xy(0, 0), Cell::xy(2, 0)];
+        c.extend((0..=to).map(|x| Cell::xy(x, 1)));
+        c
+    };
+    // Arm to x = 3: centre of mass 4/3, inside: both feet press.
+    let s = structure(&SquareLattice, ground, &deck(3), &[], &[]);
+    let a = tight(square_model(0.0)).analyse(&s);
+    assert_eq!(a.verdict(), Verdict::Stable);
+    for (l, r) in s.links.iter().zip(&a.links) {
+        if l.is_ground() {
+            assert!(!r.released && r.load.axial < 0.0, "{r:?}");
+        }
+    }
+    // Arm to x = 7: centre of mass 3 > 2½: both feet let go, it tips.
+    let s2 = structure(&SquareLattice, ground, &deck(7), &[], &[]);
+    let b = tight(square_model(0.0)).analyse(&s2);
+    assert_eq!(b.verdict(), Verdict::NoEquilibrium);
+    assert_eq!(b.unsupported.len(), 10);
+    // Latched to the ground it holds.
+    let c = tight(square_model(20.0)).analyse(&s2);
+    assert_eq!(c.verdict(), Verdict::Stable);
+}
+
+#[test]
+fn a_floating_part_has_no_equilibrium() {
+    let cells = vec![Cell::new(0, 0, 0), Cell::new(1, 0, 0), Cell::new(5, 5, 3)];
+    let s = structure(&FccLattice, None, &cells, &[0], &[]);
+    let a = tight(Model::default_catom()).analyse(&s);
+    assert_eq!(a.verdict(), Verdict::NoEquilibrium);
+    assert_eq!(a.unsupported, vec![s.body_of(3).unwrap()]);
+}
+
+#[test]
+fn a_long_cantilever_is_overloaded_at_its_root() {
+    let model = Model::default_catom().with_connector(10e3, Bending::RigidHinge);
+    let cells: Vec<Cell> = (0..=4).map(|i| Cell::new(i, 0, 0)).collect();
+    let s = structure(&FccLattice, None, &cells, &[0], &[]);
+    let a = tight(model).analyse(&s);
+    assert_eq!(a.verdict(), Verdict::Overloaded);
+    assert_eq!(
+        a.critical,
+        Some(super::analysis::Critical::Link(link_between(&s, 1, 2)))
+    );
+}
+
+#[test]
+fn incremental_reuse_gives_the_same_answer_as_from_scratch() {
+    let model = Model::default_catom();
+    let mut cells: Vec<Cell> = Vec::new();
+    for x in 0..6 {
+        for y in 0..3 {
+            cells.push(Cell::new(x, y, 0));
+        }
+    }
+    let fixed: Vec<usize> = (0..3).collect();
+    let mut inc = Analyzer::new(model.clone(), true);
+    let mut scratch = Analyzer::new(model.clone(), false);
+    // Grow a second layer module by module: each step the incremental
+    // analyser reuses the previous displacements.
+    for k in 0..5 {
+        cells.push(Cell::new(k, 1, 1));
+        let s = structure(&FccLattice, None, &cells, &fixed, &[]);
+        let (a, b) = (inc.analyse(&s), scratch.analyse(&s));
+        assert!((a.max_utilisation - b.max_utilisation).abs() < 1e-6 * b.max_utilisation);
+        // Analysing the same structure again solves nothing.
+        let again = inc.analyse(&s);
+        assert_eq!(again.components_solved, 0);
+        assert_eq!(again.max_utilisation, a.max_utilisation);
+    }
+}
+
+#[test]
+fn multigrid_and_block_jacobi_solves_agree_on_a_large_block() {
+    // 8 × 8 × 4 free modules on a fixed layer, plus an overhanging arm.
+    let mut cells = Vec::new();
+    for z in 0..5 {
+        for x in 0..8 {
+            for y in 0..8 {
+                cells.push(Cell::new(x, y, z));
+            }
+        }
+    }
+    cells.extend((8..12).map(|x| Cell::new(x, 3, 4)));
+    let fixed: Vec<usize> = (0..64).collect();
+    let s = structure(&FccLattice, None, &cells, &fixed, &[]);
+    let model = Model::default_catom();
+    let mut mg = tight(model.clone());
+    mg.settings.tolerance = 1e-11;
+    let mut jac = tight(model);
+    jac.settings.tolerance = 1e-11;
+    jac.settings.multigrid_from = usize::MAX;
+    let (a, b) = (mg.analyse(&s), jac.analyse(&s));
+    assert!(
+        a.iterations < b.iterations / 3,
+        "multigrid {} vs Jacobi {} iterations",
+        a.iterations,
+        b.iterations
+    );
+    let scale = a.max_utilisation;
+    for (x, y) in a.links.iter().zip(&b.links) {
+        assert!((x.utilisation - y.utilisation).abs() < 1e-6 * scale);
+    }
+}
+
+#[test]
+fn reused_components_keep_their_released_ground_contacts() {
+    // The same tipping-prone deck, analysed in two steps with an unrelated
+    // part changing in between: the reused deck keeps its lifted contact.
+    let ground = Some(Ground { layer: 0 });
+    let mut deck = vec![Cell::xy(0, 0), Cell::xy(2, 0)];
+    deck.extend((0..=4).map(|x| Cell::xy(x, 1)));
+    let mut inc = Analyzer::new(square_model(0.0), true);
+    let mut first = deck.clone();
+    first.push(Cell::xy(10, 0));
+    let mut second = deck.clone();
+    second.extend([Cell::xy(10, 0), Cell::xy(10, 1)]);
+    let s1 = structure(&SquareLattice, ground, &first, &[], &[]);
+    let s2 = structure(&SquareLattice, ground, &second, &[], &[]);
+    let a1 = inc.analyse(&s1);
+    let a2 = inc.analyse(&s2);
+    assert_eq!(a2.components_reused, 1);
+    let fresh = Analyzer::new(square_model(0.0), false).analyse(&s2);
+    for (x, y) in a2.links.iter().zip(&fresh.links) {
+        assert_eq!(x.released, y.released);
+        assert!((x.utilisation - y.utilisation).abs() < 1e-6);
+    }
+    assert!(a1.links.iter().any(|r| r.released) == fresh.links.iter().any(|r| r.released));
+}

@@ -1,0 +1,536 @@
+//! The branch-length study (issue #4, SPEC §7): for a family of schedules
+//! parameterised by the branch length `b`, check every intermediate
+//! structure mechanically and find the largest `b` a connector pressure
+//! allows — and the pressure each `b` needs — beside the closed-form bound
+//! of the worst cantilever (a horizontal branch with a free agent at its
+//! tip).
+//!
+//! Connector loads of the elastic model do not depend on the connector
+//! pressure, so one pass per `b` gives the minimum pressure under both
+//! bending criteria, and `b_max(p)` for any `p` follows without
+//! re-solving.
+
+use crate::certify::load_check::replay;
+use crate::certify::report::ViolationKind;
+use crate::error::InputError;
+use crate::mechanics::analysis::{Critical, Verdict};
+use crate::mechanics::capacity::required_pressure;
+use crate::mechanics::closed_form;
+use crate::mechanics::model::{Bending, Model};
+use crate::schedule::Schedule;
+use serde::Serialize;
+
+/// Results for one branch length.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub b: usize,
+    pub steps: usize,
+    /// Lattice-level violations of the generated schedule (should be 0).
+    pub lattice_violations: usize,
+    /// Largest connector utilisation over every step, at the model's `p`.
+    pub max_utilisation: f64,
+    pub critical_step: usize,
+    pub critical_connector: String,
+    /// Some step has no equilibrium whatever the connectors (tips, floats).
+    pub no_equilibrium: bool,
+    /// Minimum connector pressure (Pa) for every step to hold, per criterion.
+    pub min_pressure_rigid_hinge: f64,
+    pub min_pressure_elastic: f64,
+    /// Closed form: root utilisation of a `b` cantilever with an agent at
+    /// its tip, and the pressures it needs.
+    pub closed_utilisation: f64,
+    pub closed_pressure_rigid_hinge: f64,
+    pub closed_pressure_elastic: f64,
+}
+
+impl Row {
+    pub fn safe(&self) -> bool {
+        self.lattice_violations == 0 && !self.no_equilibrium && self.max_utilisation <= 1.0 + 1e-9
+    }
+
+    pub fn min_pressure(&self, bending: Bending) -> f64 {
+        match bending {
+            Bending::RigidHinge => self.min_pressure_rigid_hinge,
+            Bending::Elastic => self.min_pressure_elastic,
+        }
+    }
+}
+
+/// `b_max` at one pressure, both criteria, simulated and closed-form.
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepRow {
+    pub pressure_kpa: f64,
+    pub b_max_rigid_hinge: usize,
+    pub b_max_elastic: usize,
+    pub closed_rigid_hinge: usize,
+    pub closed_elastic: usize,
+}
+
+/// The whole study.
+#[derive(Clone, Debug, Serialize)]
+pub struct Study {
+    pub family: String,
+    pub model: String,
+    pub pressure_kpa: f64,
+    pub bending: Bending,
+    pub rows: Vec<Row>,
+    /// Largest studied `b` such that every `b' ≤ b` is safe (0 if none).
+    pub b_max: usize,
+    /// Closed-form bound for the model (cantilever with agent at the tip).
+    pub closed_b_max: usize,
+    pub sweep: Vec<SweepRow>,
+}
+
+/// A generator of one schedule per branch length `b`.
+pub type FamilyFn = Box<dyn Fn(usize) -> Result<Schedule, InputError>>;
+
+/// The shape families `reconfcheck b-study --family` knows, each a
+/// schedule generator over `b` at lattice spacing `spacing_mm`. To add one
+/// (e.g. seed 000's `pyramid` or `cube` scaffolds), add an arm here that
+/// calls its generator with the branch length.
+pub fn family(name: &str, spacing_mm: f64) -> Result<FamilyFn, InputError> {
+    match name {
+        "branch" => Ok(Box::new(move |b| {
+            crate::algorithms::branch::branch_schedule(b, spacing_mm)
+        })),
+        other => Err(InputError::new(format!(
+            "unknown b-study family '{other}' (known: {})",
+            FAMILIES.join(", ")
+        ))),
+    }
+}
+
+/// Names accepted by [`family`].
+pub const FAMILIES: &[&str] = &["branch"];
+
+/// Pressures of the sweep (kPa): 1…150, SPEC §7.
+pub fn sweep_pressures() -> Vec<f64> {
+    let mut v: Vec<f64> = (1..=20).map(f64::from).collect();
+    v.extend((25..=150).step_by(5).map(f64::from));
+    v
+}
+
+/// Runs the study for `lengths` with `generate(b)` producing the schedule.
+pub fn b_study(
+    family: &str,
+    model: &Model,
+    lengths: &[usize],
+    generate: impl Fn(usize) -> Result<Schedule, InputError>,
+) -> Result<Study, InputError> {
+    let mut rows = Vec::new();
+    for &b in lengths {
+        let schedule = generate(b)?;
+        let m = model.at_spacing(schedule.spacing.metres());
+        let mut row = Row {
+            b,
+            steps: schedule.steps.len(),
+            lattice_violations: 0,
+            max_utilisation: 0.0,
+            critical_step: 0,
+            critical_connector: String::new(),
+            no_equilibrium: false,
+            min_pressure_rigid_hinge: 0.0,
+            min_pressure_elastic: 0.0,
+            closed_utilisation: closed_form::cantilever_utilisation(&m, b, true),
+            closed_pressure_rigid_hinge: closed_form::cantilever_pressure(
+                &m.with_connector(m.connector.pressure, Bending::RigidHinge),
+                b,
+                true,
+            ),
+            closed_pressure_elastic: closed_form::cantilever_pressure(
+                &m.with_connector(m.connector.pressure, Bending::Elastic),
+                b,
+                true,
+            ),
+        };
+        let hinge = crate::mechanics::model::Capacity {
+            bending: Bending::RigidHinge,
+            ..m.connector
+        };
+        let elastic = crate::mechanics::model::Capacity {
+            bending: Bending::Elastic,
+            ..m.connector
+        };
+        replay(&schedule, &m, true, |step, s, a, out| {
+            row.lattice_violations += out
+                .violations
+                .iter()
+                .filter(|v| !matches!(v.kind, ViolationKind::Overload | ViolationKind::Unstable))
+                .count();
+            if a.verdict() == Verdict::NoEquilibrium {
+                row.no_equilibrium = true;
+            }
+            if a.max_utilisation > row.max_utilisation {
+                row.max_utilisation = a.max_utilisation;
+                row.critical_step = step;
+                row.critical_connector = match a.critical {
+                    Some(Critical::Link(i)) => s.describe(&s.links[i]),
+                    Some(Critical::Pivot(i)) => {
+                        let h = &s.hanging[a.pivots[i].hanging];
+                        format!("pivot connector {}–{}", h.mover, s.bodies[h.pivot].module)
+                    }
+                    None => String::new(),
+                };
+            }
+            let loads = s
+                .links
+                .iter()
+                .zip(&a.links)
+                .filter(|(l, r)| !l.is_ground() && !r.released)
+                .map(|(_, r)| r.load)
+                .chain(a.pivots.iter().map(|p| p.load));
+            for load in loads {
+                row.min_pressure_rigid_hinge = row
+                    .min_pressure_rigid_hinge
+                    .max(required_pressure(&load, &hinge));
+                row.min_pressure_elastic = row
+                    .min_pressure_elastic
+                    .max(required_pressure(&load, &elastic));
+            }
+        })?;
+        if row.no_equilibrium {
+            row.min_pressure_rigid_hinge = f64::INFINITY;
+            row.min_pressure_elastic = f64::INFINITY;
+        }
+        rows.push(row);
+    }
+    let prefix_max = |ok: &dyn Fn(&Row) -> bool| {
+        let mut best = 0;
+        let mut sorted: Vec<&Row> = rows.iter().collect();
+        sorted.sort_by_key(|r| r.b);
+        for r in sorted {
+            if r.lattice_violations == 0 && ok(r) {
+                best = r.b;
+            } else {
+                break;
+            }
+        }
+        best
+    };
+    let b_max = prefix_max(&|r: &Row| r.safe());
+    let sweep = sweep_pressures()
+        .into_iter()
+        .map(|kpa| {
+            let p = kpa * 1e3;
+            SweepRow {
+                pressure_kpa: kpa,
+                b_max_rigid_hinge: prefix_max(&|r: &Row| {
+                    r.min_pressure_rigid_hinge <= p * (1.0 + 1e-9)
+                }),
+                b_max_elastic: prefix_max(&|r: &Row| r.min_pressure_elastic <= p * (1.0 + 1e-9)),
+                closed_rigid_hinge: closed_form::cantilever_max_length(
+                    &model.with_connector(p, Bending::RigidHinge),
+                    true,
+                ),
+                closed_elastic: closed_form::cantilever_max_length(
+                    &model.with_connector(p, Bending::Elastic),
+                    true,
+                ),
+            }
+        })
+        .collect();
+    Ok(Study {
+        family: family.to_string(),
+        model: model.name.clone(),
+        pressure_kpa: model.connector.pressure / 1e3,
+        bending: model.connector.bending,
+        rows,
+        b_max,
+        closed_b_max: closed_form::cantilever_max_length(model, true),
+        sweep,
+    })
+}
+
+impl Study {
+    /// The study as text tables.
+    pub fn table(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "b-study: family '{}', model '{}' (p = {} kPa, {} bending)",
+            self.family,
+            self.model,
+            self.pressure_kpa,
+            self.bending.name()
+        );
+        let _ = writeln!(
+            s,
+            "{:>4} {:>6} {:>9} {:>9} {:>6} {:>10} {:>10} {:>10} {:>10}  critical",
+            "b",
+            "steps",
+            "max util",
+            "closed",
+            "safe",
+            "p_min RH",
+            "p_min EL",
+            "closed RH",
+            "closed EL"
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                s,
+                "{:>4} {:>6} {:>9.4} {:>9.4} {:>6} {:>10.2} {:>10.2} {:>10.2} {:>10.2}  step {}: {}",
+                r.b,
+                r.steps,
+                r.max_utilisation,
+                r.closed_utilisation,
+                if r.safe() { "yes" } else { "NO" },
+                r.min_pressure_rigid_hinge / 1e3,
+                r.min_pressure_elastic / 1e3,
+                r.closed_pressure_rigid_hinge / 1e3,
+                r.closed_pressure_elastic / 1e3,
+                r.critical_step,
+                r.critical_connector
+            );
+        }
+        let _ = writeln!(
+            s,
+            "largest safe b at {} kPa ({}): {} (closed form, cantilever with agent at tip: {})",
+            self.pressure_kpa,
+            self.bending.name(),
+            self.b_max,
+            self.closed_b_max
+        );
+        let _ = writeln!(
+            s,
+            "pressures in kPa; RH = rigid-hinge, EL = elastic bending"
+        );
+        let _ = writeln!(
+            s,
+            "\nb_max against pressure (largest studied b that holds; closed form beside):"
+        );
+        let _ = writeln!(
+            s,
+            "{:>7} {:>6} {:>6} {:>9} {:>9}",
+            "p kPa", "RH", "EL", "closed RH", "closed EL"
+        );
+        for w in &self.sweep {
+            let _ = writeln!(
+                s,
+                "{:>7} {:>6} {:>6} {:>9} {:>9}",
+                w.pressure_kpa,
+                w.b_max_rigid_hinge,
+                w.b_max_elastic,
+                w.closed_rigid_hinge,
+                w.closed_elastic
+            );
+        }
+        s
+    }
+
+    /// Plots utilisation against `b` (at the model's pressure) and the
+    /// minimum pressure against `b` (both criteria), with the closed forms.
+    pub fn plot(&self, path: &std::path::Path) -> Result<(), String> {
+        use plotters::prelude::*;
+        let mut svg = String::new();
+        {
+            let root =
+                crate::render::SvgCanvas::with_string(&mut svg, (1200, 500)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let (left, right) = root.split_horizontally(600);
+            let bmax = self.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 0.5;
+            let umax = self
+                .rows
+                .iter()
+                .flat_map(|r| [r.max_utilisation, r.closed_utilisation])
+                .filter(|u| u.is_finite())
+                .fold(1.2f64, f64::max)
+                * 1.05;
+            let mut c = ChartBuilder::on(&left)
+                .caption(
+                    format!(
+                        "max connector utilisation, p = {} kPa ({})",
+                        self.pressure_kpa,
+                        self.bending.name()
+                    ),
+                    ("sans-serif", 18),
+                )
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(55)
+                .build_cartesian_2d(0.5..bmax, 0.0..umax)
+                .map_err(|e| e.to_string())?;
+            c.configure_mesh()
+                .x_desc("branch length b (modules)")
+                .y_desc("load / capacity")
+                .draw()
+                .map_err(|e| e.to_string())?;
+            c.draw_series(LineSeries::new(
+                [(0.5, 1.0), (bmax, 1.0)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+            let sim: Vec<(f64, f64)> = self
+                .rows
+                .iter()
+                .map(|r| (r.b as f64, r.max_utilisation.min(umax)))
+                .collect();
+            c.draw_series(LineSeries::new(sim.clone(), BLUE.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label("every step, static analysis")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLUE.stroke_width(2)));
+            c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
+                .map_err(|e| e.to_string())?;
+            let closed: Vec<(f64, f64)> = self
+                .rows
+                .iter()
+                .map(|r| (r.b as f64, r.closed_utilisation.min(umax)))
+                .collect();
+            c.draw_series(LineSeries::new(closed, RED.stroke_width(1)))
+                .map_err(|e| e.to_string())?
+                .label("closed form: cantilever + agent at tip")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RED.stroke_width(1)));
+            c.configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()
+                .map_err(|e| e.to_string())?;
+
+            let pmax = self
+                .rows
+                .iter()
+                .flat_map(|r| {
+                    [
+                        r.min_pressure_rigid_hinge,
+                        r.min_pressure_elastic,
+                        r.closed_pressure_elastic,
+                    ]
+                })
+                .filter(|p| p.is_finite())
+                .fold(150e3f64, f64::max)
+                / 1e3
+                * 1.5;
+            let mut c = ChartBuilder::on(&right)
+                .caption("minimum connector pressure", ("sans-serif", 18))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(55)
+                .build_cartesian_2d(0.5..bmax, (0.1..pmax).log_scale())
+                .map_err(|e| e.to_string())?;
+            c.configure_mesh()
+                .x_desc("branch length b (modules)")
+                .y_desc("p (kPa)")
+                .draw()
+                .map_err(|e| e.to_string())?;
+            for (kpa, label) in [
+                (15.0, "practical electroadhesion 15 kPa"),
+                (133.0, "ideal parallel plate 133 kPa"),
+            ] {
+                c.draw_series(LineSeries::new(
+                    [(0.5, kpa), (bmax, kpa)],
+                    BLACK.mix(0.5).stroke_width(1),
+                ))
+                .map_err(|e| e.to_string())?;
+                c.draw_series(std::iter::once(Text::new(
+                    label,
+                    (0.7, kpa * 1.08),
+                    ("sans-serif", 12),
+                )))
+                .map_err(|e| e.to_string())?;
+            }
+            let series = [
+                (Bending::RigidHinge, BLUE, "rigid hinge"),
+                (Bending::Elastic, GREEN, "elastic"),
+            ];
+            for (bending, colour, name) in series {
+                let pts: Vec<(f64, f64)> = self
+                    .rows
+                    .iter()
+                    .filter(|r| r.min_pressure(bending).is_finite())
+                    .map(|r| (r.b as f64, (r.min_pressure(bending) / 1e3).max(0.1)))
+                    .collect();
+                c.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+                    .map_err(|e| e.to_string())?
+                    .label(format!("{name}, every step"))
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
+                    });
+                c.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                    .map_err(|e| e.to_string())?;
+                let closed: Vec<(f64, f64)> = self
+                    .rows
+                    .iter()
+                    .map(|r| {
+                        let p = match bending {
+                            Bending::RigidHinge => r.closed_pressure_rigid_hinge,
+                            Bending::Elastic => r.closed_pressure_elastic,
+                        };
+                        (r.b as f64, (p / 1e3).max(0.1))
+                    })
+                    .collect();
+                c.draw_series(DashedLineSeries::new(closed, 6, 4, colour.stroke_width(1)))
+                    .map_err(|e| e.to_string())?
+                    .label(format!("{name}, closed form"))
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(1))
+                    });
+            }
+            c.configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::LowerRight)
+                .draw()
+                .map_err(|e| e.to_string())?;
+            root.present().map_err(|e| e.to_string())?;
+        }
+        crate::render::save(&svg, path, 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algorithms::branch::branch_schedule;
+
+    #[test]
+    fn the_branch_study_agrees_with_the_closed_form_cantilever_bound() {
+        let model = Model::default_catom();
+        let lengths: Vec<usize> = (1..=7).collect();
+        let st = b_study("branch", &model, &lengths, |b| branch_schedule(b, 3.6)).unwrap();
+        for r in &st.rows {
+            assert_eq!(r.lattice_violations, 0);
+            // The worst step of growing a branch of b is the last agent
+            // hanging beyond the tip of b − 1 modules: (b)² / 2 · W·d at the
+            // root — the closed form for b − 1 modules plus an agent.
+            let expected = closed_form::cantilever_utilisation(&model, r.b - 1, true);
+            assert!(
+                (r.max_utilisation - expected).abs() < 1e-6 * expected.max(1e-3),
+                "b = {}: {} vs {expected}",
+                r.b,
+                r.max_utilisation
+            );
+        }
+        // 100 kPa rigid hinge: b² ≤ pL³/(mgd) ≈ 46.6 → b = 6 grows, 7 fails.
+        assert_eq!(st.b_max, 6);
+        assert!(st.rows[6].max_utilisation > 1.0 && !st.rows[6].safe());
+        // At the minimum pressure the worst step is exactly at capacity.
+        let r = &st.rows[5];
+        let at = model.with_connector(r.min_pressure_rigid_hinge, Bending::RigidHinge);
+        let u = closed_form::cantilever_utilisation(&at, r.b - 1, true);
+        assert!((u - 1.0).abs() < 1e-6, "{u}");
+        // The sweep is monotone and matches the table at 100 kPa.
+        let at100 = st.sweep.iter().find(|w| w.pressure_kpa == 100.0).unwrap();
+        assert_eq!(at100.b_max_rigid_hinge, 6);
+        assert!(at100.b_max_elastic < 6);
+        assert!(
+            st.sweep
+                .windows(2)
+                .all(|w| w[0].b_max_rigid_hinge <= w[1].b_max_rigid_hinge)
+        );
+    }
+
+    #[test]
+    fn the_plot_is_written_as_png() {
+        let model = Model::default_catom();
+        let st = b_study("branch", &model, &[1, 2, 3], |b| branch_schedule(b, 3.6)).unwrap();
+        let dir = std::env::temp_dir().join(format!("reconfcheck-bstudy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("b.png");
+        st.plot(&p).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

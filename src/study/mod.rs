@@ -1,0 +1,5 @@
+//! Studies built on certification: the branch-length (`b`) upper bound.
+
+pub mod b_study;
+pub mod loadmap;
+pub mod synthetic;
