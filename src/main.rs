@@ -18,7 +18,11 @@ const EXIT_INPUT: u8 = 2;
 const EXIT_OUTPUT: u8 = 3;
 
 #[derive(Parser)]
-#[command(name = "reconfcheck", version, about = "Certifies that a lattice modular robot's reconfiguration is physically feasible.")]
+#[command(
+    name = "reconfcheck",
+    version,
+    about = "Certifies that a lattice modular robot's reconfiguration is physically feasible."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

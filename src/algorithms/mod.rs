@@ -5,6 +5,7 @@
 //! on the lattice and schedule layers only, never on certification.
 
 pub mod random_walk;
+pub mod scaffold;
 pub mod schedule_file;
 
 use crate::error::InputError;
@@ -23,7 +24,11 @@ pub trait Generator: Sync {
 
 /// Every generator this build knows.
 pub fn registry() -> Vec<&'static dyn Generator> {
-    vec![&schedule_file::ScheduleFile, &random_walk::RandomWalk]
+    vec![
+        &schedule_file::ScheduleFile,
+        &random_walk::RandomWalk,
+        &scaffold::ScaffoldAssembly,
+    ]
 }
 
 /// Finds the generator a scenario names.
@@ -52,9 +57,10 @@ pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
 
 /// Reads a generator's parameters from the scenario's `[parameters]` table.
 pub fn parameters<P: DeserializeOwned>(scenario: &Scenario) -> Result<P, InputError> {
-    scenario
-        .parameters
-        .clone()
-        .try_into()
-        .map_err(|e| scenario.error(format!("bad [parameters] for '{}': {e}", scenario.algorithm)))
+    scenario.parameters.clone().try_into().map_err(|e| {
+        scenario.error(format!(
+            "bad [parameters] for '{}': {e}",
+            scenario.algorithm
+        ))
+    })
 }

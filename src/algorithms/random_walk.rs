@@ -5,10 +5,10 @@
 //! in layer 1, rolling over the platform modules of layer 0, so every
 //! walker is held by a fixed pivot and the static structure stays anchored.
 
-use super::{parameters, Generator};
+use super::{Generator, parameters};
 use crate::error::InputError;
 use crate::lattice::config::{Configuration, Ground, ModuleId};
-use crate::lattice::{fcc, Cell, FccLattice, Lattice, LatticeKind, Motion, Route};
+use crate::lattice::{Cell, FccLattice, Lattice, LatticeKind, Motion, Route, fcc};
 use crate::scenario::Scenario;
 use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
 use rand::seq::SliceRandom;
@@ -84,7 +84,11 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
     for x in 0..p.width {
         for y in 0..p.depth {
             let c = Cell::new(x, y, 0);
-            s.modules.push(ModuleSpec { id, cell: c, fixed: true });
+            s.modules.push(ModuleSpec {
+                id,
+                cell: c,
+                fixed: true,
+            });
             config.insert(id, c).expect("distinct cells");
             id += 1;
         }
@@ -97,7 +101,11 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
     spots.shuffle(&mut rng);
     let mut walkers = Vec::new();
     for &c in spots.iter().take(p.walkers) {
-        s.modules.push(ModuleSpec { id, cell: c, fixed: false });
+        s.modules.push(ModuleSpec {
+            id,
+            cell: c,
+            fixed: false,
+        });
         config.insert(id, c).expect("distinct cells");
         walkers.push(id);
         id += 1;
@@ -120,14 +128,13 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
                 .filter(|c| platform.contains(c))
                 .collect();
             pivots.shuffle(&mut rng);
-            let Some(&pivot) = pivots.first() else { continue };
+            let Some(&pivot) = pivots.first() else {
+                continue;
+            };
             let mut targets: Vec<Cell> = (4..8)
                 .map(|k| l.neighbour(pivot, k))
                 .filter(|&t| {
-                    t != from
-                        && config.is_free(t)
-                        && !claimed.contains(&t)
-                        && !leaving.contains(&t)
+                    t != from && config.is_free(t) && !claimed.contains(&t) && !leaving.contains(&t)
                 })
                 .collect();
             targets.shuffle(&mut rng);
@@ -140,12 +147,23 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
                     &[Route::Octagonal]
                 };
                 let route = routes[rng.random_range(0..routes.len())];
-                let m = Motion::Rotate { from, to, pivot, route };
+                let m = Motion::Rotate {
+                    from,
+                    to,
+                    pivot,
+                    route,
+                };
                 if !filter(&config, &m, &chosen) {
                     continue;
                 }
                 let pivot_id = config.at(pivot).expect("platform pivot");
-                events.push(Event::Rotate { module: w, pivot: pivot_id, from, to, route });
+                events.push(Event::Rotate {
+                    module: w,
+                    pivot: pivot_id,
+                    from,
+                    to,
+                    route,
+                });
                 claimed.insert(to);
                 leaving.insert(from);
                 chosen.push(m);
@@ -155,7 +173,9 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
         for e in &events {
             if let Event::Rotate { module, to, .. } = e {
                 config.remove(*module);
-                config.insert(*module, *to).expect("claimed targets are distinct");
+                config
+                    .insert(*module, *to)
+                    .expect("claimed targets are distinct");
             }
         }
         events.sort_by_key(Event::module);

@@ -1,6 +1,6 @@
 //! The trivial generator: a hand-written schedule file.
 
-use super::{parameters, Generator};
+use super::{Generator, parameters};
 use crate::error::InputError;
 use crate::scenario::Scenario;
 use crate::schedule::Schedule;

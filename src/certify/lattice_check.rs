@@ -29,7 +29,10 @@ impl StepCheck for LatticeCheck {
                         Violation::new(
                             ViolationKind::PivotMoving,
                             step,
-                            format!("module {} rolls on pivot {p}, which moves in the same step", m.module),
+                            format!(
+                                "module {} rolls on pivot {p}, which moves in the same step",
+                                m.module
+                            ),
                         )
                         .modules([m.module, p]),
                     );
@@ -38,7 +41,10 @@ impl StepCheck for LatticeCheck {
                         Violation::new(
                             ViolationKind::MoverDetached,
                             step,
-                            format!("module {} moves on pivot {p}, but their connectors are released", m.module),
+                            format!(
+                                "module {} moves on pivot {p}, but their connectors are released",
+                                m.module
+                            ),
                         )
                         .modules([m.module, p]),
                     );
@@ -113,7 +119,11 @@ impl StepCheck for LatticeCheck {
                     .cells([cell]),
                 );
             }
-            let held = w.lattice.neighbours(cell).iter().any(|&n| w.is_support(n, moving));
+            let held = w
+                .lattice
+                .neighbours(cell)
+                .iter()
+                .any(|&n| w.is_support(n, moving));
             if !held {
                 out.violations.push(
                     Violation::new(
@@ -150,7 +160,8 @@ impl StepCheck for LatticeCheck {
         for &(a, b) in plan.attaches.iter().chain(&plan.detaches) {
             let (ca, cb) = (w.config.cell_of(a), w.config.cell_of(b));
             if let (Some(ca), Some(cb)) = (ca, cb) {
-                if !w.lattice.are_neighbours(ca, cb) && !moving.contains(&a) && !moving.contains(&b) {
+                if !w.lattice.are_neighbours(ca, cb) && !moving.contains(&a) && !moving.contains(&b)
+                {
                     out.violations.push(
                         Violation::new(
                             ViolationKind::LatchNotAdjacent,

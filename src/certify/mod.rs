@@ -73,7 +73,10 @@ pub trait StepCheck: Send + Sync {
 
 /// The checks that apply to a schedule: the lattice checks always, the
 /// collision check where the lattice has a body model.
-pub fn checks_for(schedule: &Schedule, opts: &Options) -> Result<Vec<Box<dyn StepCheck>>, InputError> {
+pub fn checks_for(
+    schedule: &Schedule,
+    opts: &Options,
+) -> Result<Vec<Box<dyn StepCheck>>, InputError> {
     let mut checks: Vec<Box<dyn StepCheck>> = vec![Box::new(LatticeCheck)];
     if opts.lattice_only {
         return Ok(checks);
@@ -128,7 +131,10 @@ pub fn certify_with(
             Violation::new(
                 ViolationKind::Disconnected,
                 0,
-                format!("the initial configuration has {} module(s) not connected to the ground", loose.len()),
+                format!(
+                    "the initial configuration has {} module(s) not connected to the ground",
+                    loose.len()
+                ),
             )
             .modules(loose),
         );
@@ -176,7 +182,10 @@ pub fn certify_with(
                 Violation::new(
                     ViolationKind::Disconnected,
                     final_step,
-                    format!("the final configuration has {} module(s) not connected to the ground", loose.len()),
+                    format!(
+                        "the final configuration has {} module(s) not connected to the ground",
+                        loose.len()
+                    ),
                 )
                 .modules(loose),
             );
@@ -199,8 +208,10 @@ fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {
     }
     let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
     bar.set_style(
-        ProgressStyle::with_template("certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})")
-            .expect("valid template"),
+        ProgressStyle::with_template(
+            "certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})",
+        )
+        .expect("valid template"),
     );
     bar
 }

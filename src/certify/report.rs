@@ -149,7 +149,11 @@ impl Report {
     /// A readable summary: verdict, counts, the first findings.
     pub fn summary(&self) -> String {
         let mut s = String::new();
-        let verdict = if self.certified { "CERTIFIED" } else { "NOT CERTIFIED" };
+        let verdict = if self.certified {
+            "CERTIFIED"
+        } else {
+            "NOT CERTIFIED"
+        };
         let _ = writeln!(
             s,
             "{verdict}: {} ({} lattice, {} modules, {} steps, {} moves)",
@@ -164,13 +168,20 @@ impl Report {
             let _ = writeln!(s, "  {n:>6} × {}", k.name());
         }
         if let Some(k) = self.stopped_at {
-            let _ = writeln!(s, "stopped after step {k}: the state is undefined from there on");
+            let _ = writeln!(
+                s,
+                "stopped after step {k}: the state is undefined from there on"
+            );
         }
         for v in self.violations.iter().take(10) {
             let _ = writeln!(s, "  step {}: {}: {}", v.step, v.kind.name(), v.message);
         }
         if self.violations.len() > 10 {
-            let _ = writeln!(s, "  … {} more violations in the JSON report", self.violations.len() - 10);
+            let _ = writeln!(
+                s,
+                "  … {} more violations in the JSON report",
+                self.violations.len() - 10
+            );
         }
         if !self.warnings.is_empty() {
             let _ = writeln!(s, "warnings: {}", self.warnings.len());

@@ -99,7 +99,10 @@ impl World {
         self.lattice.check_cell(c)?;
         if let Some(g) = self.ground {
             if g.is_ground_cell(self.lattice, c) {
-                return Err(format!("cell {c} is inside the ground (below layer {})", g.layer));
+                return Err(format!(
+                    "cell {c} is inside the ground (below layer {})",
+                    g.layer
+                ));
             }
         }
         Ok(())
@@ -112,7 +115,10 @@ impl World {
     /// Whether cell `c` holds a module that can bear on a mover during a
     /// step: a module that is not moving, or the ground.
     pub fn is_support(&self, c: Cell, moving: &FxHashSet<ModuleId>) -> bool {
-        if self.ground.is_some_and(|g| g.is_ground_cell(self.lattice, c)) {
+        if self
+            .ground
+            .is_some_and(|g| g.is_ground_cell(self.lattice, c))
+        {
             return true;
         }
         self.config.at(c).is_some_and(|m| !moving.contains(&m))
@@ -121,13 +127,10 @@ impl World {
     /// The modules not connected to the ground or a fixed module, with
     /// `exclude` taken out of the structure.
     pub fn unanchored(&self, exclude: &FxHashSet<ModuleId>) -> Vec<ModuleId> {
-        self.config.unanchored(
-            self.lattice,
-            self.ground,
-            &self.fixed,
-            exclude,
-            &|a, b| self.latched(a, b),
-        )
+        self.config
+            .unanchored(self.lattice, self.ground, &self.fixed, exclude, &|a, b| {
+                self.latched(a, b)
+            })
     }
 
     fn require_present(&self, id: ModuleId, step: usize) -> Result<Cell, InputError> {
@@ -160,7 +163,9 @@ impl World {
                         Event::Rotate { from, pivot, .. } => (*from, Some(*pivot)),
                         Event::Slide { from, pivot, .. } => (*from, *pivot),
                         Event::Tunnel { path, .. } => {
-                            let first = *path.first().ok_or_else(|| err("empty tunnel path".into()))?;
+                            let first = *path
+                                .first()
+                                .ok_or_else(|| err("empty tunnel path".into()))?;
                             (first, None)
                         }
                         _ => unreachable!(),
@@ -222,9 +227,9 @@ impl World {
                     }
                     let pivot_resolved = pivot_id.is_none() || pivot_cell.is_some();
                     let requirements = if pivot_resolved {
-                        self.lattice
-                            .move_requirements(&motion)
-                            .map_err(|e| err(format!("not a {} move: {e}", self.lattice.kind().name())))?
+                        self.lattice.move_requirements(&motion).map_err(|e| {
+                            err(format!("not a {} move: {e}", self.lattice.kind().name()))
+                        })?
                     } else {
                         MoveRequirements::default()
                     };
@@ -239,7 +244,9 @@ impl World {
                 }
                 Event::Enter { cell, .. } => {
                     if self.config.contains(id) {
-                        return Err(err(format!("module {id} enters but is already in the scene")));
+                        return Err(err(format!(
+                            "module {id} enters but is already in the scene"
+                        )));
                     }
                     self.check_cell(*cell).map_err(err)?;
                     plan.enters.push((id, *cell));
@@ -281,7 +288,9 @@ impl World {
                     Violation::new(
                         ViolationKind::Occupancy,
                         plan.step,
-                        format!("two modules in one cell: {id} and {other} both end the step at {to}"),
+                        format!(
+                            "two modules in one cell: {id} and {other} both end the step at {to}"
+                        ),
                     )
                     .modules([id, other])
                     .cells([to]),

@@ -81,7 +81,9 @@ pub trait MotionRules: Send + Sync {
     /// Whether `motion` is free of collisions with static modules, given
     /// which cells are occupied at the start of the step.
     fn allows(&self, motion: &Motion, occupied: &dyn Fn(crate::lattice::Cell) -> bool) -> bool {
-        self.blocking_cells(motion).into_iter().all(|c| !occupied(c))
+        self.blocking_cells(motion)
+            .into_iter()
+            .all(|c| !occupied(c))
     }
 }
 

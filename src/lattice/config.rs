@@ -110,8 +110,7 @@ impl Configuration {
             if exclude.contains(&m) {
                 continue;
             }
-            let anchored =
-                fixed.contains(&m) || ground.is_some_and(|g| g.touches(lattice, c));
+            let anchored = fixed.contains(&m) || ground.is_some_and(|g| g.touches(lattice, c));
             if anchored && seen.insert(m) {
                 stack.push((m, c));
             }

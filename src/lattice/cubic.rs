@@ -96,7 +96,12 @@ mod tests {
     fn tunnel_path_must_be_contiguous() {
         let l = CubicLattice;
         let ok = Motion::Tunnel {
-            path: vec![Cell::new(0, 0, 1), Cell::new(0, 0, 0), Cell::new(1, 0, 0), Cell::new(1, 0, 1)],
+            path: vec![
+                Cell::new(0, 0, 1),
+                Cell::new(0, 0, 0),
+                Cell::new(1, 0, 0),
+                Cell::new(1, 0, 1),
+            ],
         };
         let r = l.move_requirements(&ok).unwrap();
         assert_eq!(r.occupied, vec![Cell::new(0, 0, 0), Cell::new(1, 0, 0)]);

@@ -323,11 +323,24 @@ mod tests {
             pivot: p,
             route: Route::Octagonal,
         };
-        assert!(matches!(l.move_requirements(&m), Err(MoveError::NotAMove(_))));
+        assert!(matches!(
+            l.move_requirements(&m),
+            Err(MoveError::NotAMove(_))
+        ));
         // 90° (+x → +y) exists only as an octagonal rotation.
         let to = l.neighbour(p, 1);
-        let hex = Motion::Rotate { from, to, pivot: p, route: Route::Hexagonal };
-        let oct = Motion::Rotate { from, to, pivot: p, route: Route::Octagonal };
+        let hex = Motion::Rotate {
+            from,
+            to,
+            pivot: p,
+            route: Route::Hexagonal,
+        };
+        let oct = Motion::Rotate {
+            from,
+            to,
+            pivot: p,
+            route: Route::Octagonal,
+        };
         assert!(l.move_requirements(&hex).is_err());
         assert_eq!(l.move_requirements(&oct).unwrap().supports, vec![p]);
     }

@@ -105,8 +105,7 @@ pub(crate) fn wall_slide(
         Some(p) => p - from,
         None => down,
     };
-    let perpendicular = side.l1() == 1
-        && side.x * d.x + side.y * d.y + side.z * d.z == 0;
+    let perpendicular = side.l1() == 1 && side.x * d.x + side.y * d.y + side.z * d.z == 0;
     if !perpendicular {
         return Err(MoveError::NotAMove(match pivot {
             Some(p) => format!(

@@ -50,7 +50,9 @@ impl Lattice for SquareLattice {
         if c.z == 0 {
             Ok(())
         } else {
-            Err(format!("cell {c} is not in the plane of the 2D square lattice (z must be 0)"))
+            Err(format!(
+                "cell {c} is not in the plane of the 2D square lattice (z must be 0)"
+            ))
         }
     }
 
@@ -60,7 +62,9 @@ impl Lattice for SquareLattice {
         };
         let d = to - from;
         if d.z != 0 || from.z != 0 {
-            return Err(MoveError::NotAMove(format!("{from} → {to} leaves the plane")));
+            return Err(MoveError::NotAMove(format!(
+                "{from} → {to} leaves the plane"
+            )));
         }
         if d.l1() == 1 {
             return wall_slide(from, to, pivot, Cell::xy(0, -1));
@@ -133,7 +137,11 @@ mod tests {
     #[test]
     fn straight_slide_needs_a_wall_on_one_side() {
         let l = SquareLattice;
-        let on_ground = Motion::Slide { from: Cell::xy(2, 1), to: Cell::xy(1, 1), pivot: None };
+        let on_ground = Motion::Slide {
+            from: Cell::xy(2, 1),
+            to: Cell::xy(1, 1),
+            pivot: None,
+        };
         assert_eq!(
             l.move_requirements(&on_ground).unwrap().supports,
             vec![Cell::xy(2, 0), Cell::xy(1, 0)]
@@ -153,7 +161,11 @@ mod tests {
             pivot: Some(Cell::xy(2, 4)),
         };
         assert!(l.move_requirements(&pivot_in_line).is_err());
-        let jump = Motion::Slide { from: Cell::xy(0, 1), to: Cell::xy(2, 1), pivot: None };
+        let jump = Motion::Slide {
+            from: Cell::xy(0, 1),
+            to: Cell::xy(2, 1),
+            pivot: None,
+        };
         assert!(l.move_requirements(&jump).is_err());
     }
 }

@@ -16,7 +16,9 @@ pub type SvgCanvas<'a> = plotters::backend::SVGBackend<'a>;
 /// Writes an SVG document to `path`: as SVG if the extension is `.svg`,
 /// otherwise rasterised to PNG at the document's own size (× `scale`).
 pub fn save(svg: &str, path: &Path, scale: f32) -> Result<(), String> {
-    let is_svg = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    let is_svg = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     if is_svg {
         return std::fs::write(path, svg).map_err(|e| format!("{}: {e}", path.display()));
     }
@@ -28,16 +30,22 @@ pub fn save(svg: &str, path: &Path, scale: f32) -> Result<(), String> {
 pub fn rasterise(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
     let opt = usvg_options();
     let tree = resvg::usvg::Tree::from_str(svg, opt).map_err(|e| format!("bad SVG: {e}"))?;
-    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty picture")?;
-    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height())
-        .ok_or("picture too large")?;
+    let size = tree
+        .size()
+        .to_int_size()
+        .scale_by(scale)
+        .ok_or("empty picture")?;
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("picture too large")?;
     pixmap.fill(resvg::tiny_skia::Color::WHITE);
     resvg::render(
         &tree,
         resvg::tiny_skia::Transform::from_scale(scale, scale),
         &mut pixmap.as_mut(),
     );
-    pixmap.encode_png().map_err(|e| format!("PNG encoding failed: {e}"))
+    pixmap
+        .encode_png()
+        .map_err(|e| format!("PNG encoding failed: {e}"))
 }
 
 fn usvg_options() -> &'static resvg::usvg::Options<'static> {

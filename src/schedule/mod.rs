@@ -153,9 +153,8 @@ impl Schedule {
 
     /// Parses a schedule from JSON text; `origin` names it in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Schedule, InputError> {
-        let schedule: Schedule = serde_json::from_str(text).map_err(|e| {
-            InputError::new(format!("not a valid schedule: {e}")).in_file(origin)
-        })?;
+        let schedule: Schedule = serde_json::from_str(text)
+            .map_err(|e| InputError::new(format!("not a valid schedule: {e}")).in_file(origin))?;
         schedule.check_header().map_err(|e| e.in_file(origin))?;
         Ok(schedule)
     }

@@ -37,7 +37,10 @@ pub struct Length {
 
 impl Length {
     pub fn mm(value: f64) -> Length {
-        Length { value, unit: Unit::Millimetre }
+        Length {
+            value,
+            unit: Unit::Millimetre,
+        }
     }
 
     pub fn metres(&self) -> f64 {
