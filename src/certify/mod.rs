@@ -126,6 +126,7 @@ pub fn certify_with(
     // The initial configuration must stand on its own.
     let nobody = Default::default();
     let loose = world.unanchored(&nobody);
+    world.set_anchored(loose.is_empty());
     if !loose.is_empty() {
         report.violations.push(
             Violation::new(
@@ -156,6 +157,12 @@ pub fn certify_with(
         }
         let clashes = world.apply(&plan);
         let stop = !clashes.is_empty();
+        let tunnels = plan
+            .moves
+            .iter()
+            .any(|m| matches!(m.motion, crate::lattice::Motion::Tunnel { .. }));
+        let lattice_clean = out.violations.iter().all(|v| !v.kind.is_lattice_level());
+        world.set_anchored(lattice_clean && plan.detaches.is_empty() && !tunnels);
         out.violations.extend(clashes);
         report.per_step.push(StepResult {
             step: index,
@@ -176,6 +183,7 @@ pub fn certify_with(
 
     if report.stopped_at.is_none() {
         let final_step = schedule.steps.len() + 1;
+        world.set_anchored(false);
         let loose = world.unanchored(&nobody);
         if !loose.is_empty() {
             report.violations.push(

@@ -43,6 +43,18 @@ pub enum ViolationKind {
 }
 
 impl ViolationKind {
+    /// Whether the kind is found by the lattice checks (as opposed to the
+    /// geometric and mechanical ones).
+    pub fn is_lattice_level(self) -> bool {
+        !matches!(
+            self,
+            ViolationKind::Collision
+                | ViolationKind::SlidingContact
+                | ViolationKind::Unstable
+                | ViolationKind::Overload
+        )
+    }
+
     pub fn name(self) -> String {
         serde_json::to_value(self)
             .ok()

@@ -20,6 +20,9 @@ pub struct World {
     detached: FxHashSet<(ModuleId, ModuleId)>,
     /// Every id that was ever in the scene, and the step it left at.
     left_at: FxHashMap<ModuleId, usize>,
+    /// Whether the configuration is known to be anchored as a whole, which
+    /// lets connectivity be checked locally around the movers.
+    anchored: bool,
 }
 
 fn pair(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
@@ -70,6 +73,7 @@ impl World {
             sinks: s.sinks.iter().copied().collect(),
             detached: FxHashSet::default(),
             left_at: FxHashMap::default(),
+            anchored: false,
         };
         for m in &s.modules {
             let err = |msg: String| InputError::new(msg).at_step(0).for_module(m.id);
@@ -133,6 +137,14 @@ impl World {
             })
     }
 
+    /// Records whether every module is known to be anchored now. True only
+    /// when established: by a full check, or by a step with no violations
+    /// and no released latches (its static part was anchored and each mover
+    /// ended latched to a static pivot or support).
+    pub fn set_anchored(&mut self, anchored: bool) {
+        self.anchored = anchored;
+    }
+
     fn require_present(&self, id: ModuleId, step: usize) -> Result<Cell, InputError> {
         if let Some(c) = self.config.cell_of(id) {
             return Ok(c);
@@ -170,6 +182,11 @@ impl World {
                         }
                         _ => unreachable!(),
                     };
+                    if self.fixed.contains(&id) {
+                        return Err(err(format!(
+                            "module {id} is fixed (ground/sandbox) and cannot move"
+                        )));
+                    }
                     if from != here {
                         return Err(err(format!(
                             "impossible move: the module is at {here}, not at {from}"

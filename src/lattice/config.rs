@@ -145,6 +145,72 @@ impl Configuration {
     }
 }
 
+impl Configuration {
+    /// Like [`Configuration::unanchored`], but assuming every module is
+    /// anchored before `exclude` is lifted (the configuration was connected),
+    /// so only the static neighbours of the lifted modules can have lost
+    /// their anchor: a component of the remainder that holds no anchor was
+    /// joined to one only through a lifted module, so it contains one of
+    /// their neighbours. Searches stop at the first anchor found, which keeps
+    /// the cost local to the movers in a well-connected structure.
+    pub fn unanchored_near(
+        &self,
+        lattice: &dyn Lattice,
+        ground: Option<Ground>,
+        fixed: &FxHashSet<ModuleId>,
+        exclude: &FxHashSet<ModuleId>,
+        latched: &dyn Fn(ModuleId, ModuleId) -> bool,
+    ) -> Vec<ModuleId> {
+        let is_anchor = |m: ModuleId, c: Cell| {
+            fixed.contains(&m) || ground.is_some_and(|g| g.touches(lattice, c))
+        };
+        let mut anchored: FxHashSet<ModuleId> = FxHashSet::default();
+        let mut loose: FxHashSet<ModuleId> = FxHashSet::default();
+        let mut seeds: Vec<(ModuleId, Cell)> = Vec::new();
+        for &x in exclude {
+            let Some(cx) = self.cell_of(x) else { continue };
+            for n in lattice.neighbours(cx) {
+                if let Some(o) = self.at(n) {
+                    if !exclude.contains(&o) && latched(x, o) {
+                        seeds.push((o, n));
+                    }
+                }
+            }
+        }
+        seeds.sort_unstable();
+        seeds.dedup();
+        for (seed, seed_cell) in seeds {
+            if anchored.contains(&seed) || loose.contains(&seed) {
+                continue;
+            }
+            let mut visited: Vec<ModuleId> = vec![seed];
+            let mut seen: FxHashSet<ModuleId> = [seed].into_iter().collect();
+            let mut queue = std::collections::VecDeque::from([(seed, seed_cell)]);
+            let mut found = false;
+            while let Some((m, c)) = queue.pop_front() {
+                if is_anchor(m, c) || anchored.contains(&m) {
+                    found = true;
+                    break;
+                }
+                for n in lattice.neighbours(c) {
+                    if let Some(o) = self.at(n) {
+                        if !exclude.contains(&o) && latched(m, o) && seen.insert(o) {
+                            visited.push(o);
+                            queue.push_back((o, n));
+                        }
+                    }
+                }
+            }
+            // A failed search exhausted its whole component: all of it is loose.
+            let target = if found { &mut anchored } else { &mut loose };
+            target.extend(visited);
+        }
+        let mut out: Vec<ModuleId> = loose.into_iter().collect();
+        out.sort_unstable();
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,5 +237,33 @@ mod tests {
         // Removing the middle of a column disconnects its top.
         let ex: FxHashSet<_> = [1].into_iter().collect();
         assert_eq!(c.unanchored(&l, g, &none, &ex, &|_, _| true), vec![2, 3]);
+    }
+
+    #[test]
+    fn the_local_search_agrees_with_the_full_one_on_a_connected_start() {
+        use rand::{Rng, SeedableRng};
+        let l = SquareLattice;
+        let g = Some(Ground { layer: 1 });
+        let none = FxHashSet::default();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..200 {
+            // A random anchored blob grown from the ground.
+            let mut c = Configuration::new();
+            let mut id = 0;
+            c.insert(id, Cell::xy(0, 1)).unwrap();
+            while c.len() < 25 {
+                let (_, base) = c.modules()[rng.random_range(0..c.len())];
+                let n = l.neighbours(base)[rng.random_range(0..4)];
+                if n.y >= 1 && c.is_free(n) {
+                    id += 1;
+                    c.insert(id, n).unwrap();
+                }
+            }
+            assert!(c.unanchored(&l, g, &none, &none, &|_, _| true).is_empty());
+            let lifted: FxHashSet<ModuleId> = (0..3).map(|_| rng.random_range(0..=id)).collect();
+            let full = c.unanchored(&l, g, &none, &lifted, &|_, _| true);
+            let near = c.unanchored_near(&l, g, &none, &lifted, &|_, _| true);
+            assert_eq!(full, near);
+        }
     }
 }

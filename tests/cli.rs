@@ -1,0 +1,277 @@
+//! The command line: exit codes, bad input named by file, step and module,
+//! byte-identical reports.
+
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reconfcheck-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let p = scratch(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn certify(path: &Path) -> Output {
+    bin()
+        .arg("certify")
+        .arg(path)
+        .arg("--lattice-only")
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A valid FCC schedule: one catom rolling twice over a fixed platform.
+fn walk() -> Value {
+    let mut modules: Vec<Value> = (0..3)
+        .flat_map(|x| {
+            (0..3).map(move |y| json!({"id": x * 3 + y, "cell": [x, y, 0], "fixed": true}))
+        })
+        .collect();
+    modules.push(json!({"id": 100, "cell": [0, 0, 1]}));
+    json!({
+        "format": "reconfcheck-schedule",
+        "version": 1,
+        "lattice": "fcc",
+        "spacing": {"value": 3.6, "unit": "mm"},
+        "ground": {"layer": 0},
+        "modules": modules,
+        "steps": [
+            {"events": [{"op": "rotate", "module": 100, "pivot": 3, "from": [0,0,1], "to": [1,0,1], "route": "octagonal"}]},
+            {"events": [{"op": "rotate", "module": 100, "pivot": 6, "from": [1,0,1], "to": [2,0,1], "route": "octagonal"}]}
+        ]
+    })
+}
+
+/// Asserts exit code 2 and an error naming the file and every `needle`.
+fn assert_input_error(name: &str, doc: &str, needles: &[&str]) {
+    let p = write(name, doc);
+    let o = certify(&p);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    assert!(
+        err.contains(name),
+        "{name}: error does not name the file: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{name}: error lacks '{n}': {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_valid_schedule_exits_zero() {
+    let p = write("valid.json", &walk().to_string());
+    let o = certify(&p);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("CERTIFIED"));
+}
+
+#[test]
+fn violations_exit_one() {
+    let mut s = walk();
+    // A second catom that ends in the same cell as the first.
+    s["modules"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"id": 101, "cell": [1, 1, 1]}));
+    s["steps"][0]["events"].as_array_mut().unwrap().push(
+        json!({"op": "rotate", "module": 101, "pivot": 4, "from": [1,1,1], "to": [1,0,1], "route": "octagonal"}),
+    );
+    let p = write("clash.json", &s.to_string());
+    let o = certify(&p);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("occupancy"));
+}
+
+#[test]
+fn malformed_json_is_unusable_input() {
+    assert_input_error(
+        "malformed.json",
+        "{\"format\": \"reconfcheck-schedule\", ",
+        &["not a valid schedule"],
+    );
+}
+
+#[test]
+fn a_missing_file_is_unusable_input() {
+    let o = bin()
+        .args(["certify", "/nonexistent/where.json"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("/nonexistent/where.json"));
+}
+
+#[test]
+fn an_unknown_lattice_is_unusable_input() {
+    let mut s = walk();
+    s["lattice"] = json!("hexagonal");
+    assert_input_error("lattice.json", &s.to_string(), &["hexagonal", "fcc"]);
+}
+
+#[test]
+fn an_unknown_version_is_unusable_input() {
+    let mut s = walk();
+    s["version"] = json!(7);
+    assert_input_error("version.json", &s.to_string(), &["version 7"]);
+}
+
+#[test]
+fn an_unknown_unit_is_unusable_input() {
+    let mut s = walk();
+    s["spacing"] = json!({"value": 3.6, "unit": "furlong"});
+    assert_input_error("unit.json", &s.to_string(), &["furlong"]);
+}
+
+#[test]
+fn an_unknown_module_id_is_named_with_its_step() {
+    let mut s = walk();
+    s["steps"][1]["events"][0]["module"] = json!(42);
+    assert_input_error(
+        "unknown.json",
+        &s.to_string(),
+        &["step 2", "module 42", "unknown module id"],
+    );
+}
+
+#[test]
+fn a_move_to_a_non_neighbour_cell_is_unusable_input() {
+    let mut s = walk();
+    s["steps"][1]["events"][0]["to"] = json!([4, 0, 1]);
+    assert_input_error(
+        "far.json",
+        &s.to_string(),
+        &["step 2", "module 100", "not a fcc move"],
+    );
+}
+
+#[test]
+fn a_move_from_the_wrong_cell_is_unusable_input() {
+    let mut s = walk();
+    s["steps"][1]["events"][0]["from"] = json!([0, 0, 1]);
+    assert_input_error(
+        "from.json",
+        &s.to_string(),
+        &["step 2", "module 100", "impossible move"],
+    );
+}
+
+#[test]
+fn two_modules_in_one_initial_cell_are_unusable_input() {
+    let mut s = walk();
+    s["modules"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"id": 101, "cell": [0, 0, 1]}));
+    assert_input_error(
+        "twice.json",
+        &s.to_string(),
+        &["step 0", "module 101", "two modules in one cell"],
+    );
+}
+
+#[test]
+fn a_pivot_that_does_not_touch_the_mover_is_unusable_input() {
+    let mut s = walk();
+    s["steps"][0]["events"][0]["pivot"] = json!(8); // platform module at (2, 2, 0)
+    assert_input_error(
+        "pivot.json",
+        &s.to_string(),
+        &["step 1", "module 100", "not a neighbour"],
+    );
+}
+
+#[test]
+fn a_fixed_module_cannot_move() {
+    let mut s = walk();
+    s["steps"][0]["events"][0] = json!({"op": "rotate", "module": 0, "pivot": 1, "from": [0,0,0], "to": [1,0,0], "route": "octagonal"});
+    assert_input_error(
+        "fixed.json",
+        &s.to_string(),
+        &["step 1", "module 0", "fixed"],
+    );
+}
+
+#[test]
+fn an_unknown_event_field_is_unusable_input() {
+    let mut s = walk();
+    s["steps"][0]["events"][0]["speed"] = json!(3);
+    assert_input_error("field.json", &s.to_string(), &["speed"]);
+}
+
+#[test]
+fn a_malformed_scenario_is_unusable_input() {
+    let p = write("bad.toml", "name = \"x\"\nalgorithm = [\n");
+    let o = bin().arg("run").arg(&p).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bad.toml"), "{}", stderr(&o));
+}
+
+#[test]
+fn an_unknown_algorithm_is_unusable_input() {
+    let p = write("algo.toml", "name = \"x\"\nalgorithm = \"teleport\"\n");
+    let o = bin().arg("run").arg(&p).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(
+        err.contains("algo.toml") && err.contains("teleport"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_bundled_default_runs_and_certifies() {
+    let o = bin().arg("run").output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("CERTIFIED"));
+}
+
+#[test]
+fn reports_are_byte_identical_across_runs() {
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/random-walk.toml");
+    let run = |name: &str| {
+        let out = scratch(name);
+        let o = bin()
+            .arg("run")
+            .arg(&scenario)
+            .arg("--json")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let (a, b) = (run("r1.json"), run("r2.json"));
+    assert!(a.len() > 1000);
+    assert_eq!(a, b);
+}
+
+#[test]
+fn generate_writes_a_schedule_that_certify_accepts() {
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/random-walk.toml");
+    let out = scratch("generated.json");
+    let o = bin()
+        .arg("generate")
+        .arg(&scenario)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = certify(&out);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}

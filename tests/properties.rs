@@ -1,0 +1,117 @@
+//! Property tests: random valid walks certify clean, and faults injected
+//! into them are caught exactly where an independent oracle says.
+
+mod common;
+use common::*;
+use proptest::prelude::*;
+use reconfcheck::algorithms::random_walk::{WalkParams, walk};
+use reconfcheck::certify::ViolationKind;
+use reconfcheck::lattice::{Cell, FccLattice, Lattice};
+use reconfcheck::schedule::{Event, ModuleSpec, Schedule};
+use std::collections::{BTreeSet, HashMap};
+
+fn params() -> impl Strategy<Value = WalkParams> {
+    (
+        3i32..8,
+        3i32..8,
+        1usize..12,
+        1usize..30,
+        0.1f64..1.0,
+        any::<u64>(),
+    )
+        .prop_map(
+            |(width, depth, walkers, steps, activity, seed)| WalkParams {
+                width,
+                depth,
+                walkers: walkers.min(((width - 1) * (depth - 1)) as usize),
+                steps,
+                activity,
+                seed,
+            },
+        )
+}
+
+/// Cells of every module at the start of each step (index 0 = initial).
+fn cells_per_step(s: &Schedule) -> Vec<HashMap<u32, Cell>> {
+    let mut now: HashMap<u32, Cell> = s.modules.iter().map(|m| (m.id, m.cell)).collect();
+    let mut out = vec![now.clone()];
+    for st in &s.steps {
+        for e in &st.events {
+            if let Event::Rotate { module, to, .. } = e {
+                now.insert(*module, *to);
+            }
+        }
+        out.push(now.clone());
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_valid_walks_certify_clean(p in params()) {
+        let s = walk(&p, &|_, _, _| true);
+        let r = lattice_report(&s);
+        prop_assert!(r.certified, "{}", r.summary());
+        prop_assert_eq!(r.moves, s.move_count());
+    }
+
+    /// A rider on top of a walker is disconnected exactly in the steps where
+    /// none of its neighbours stays put (computed here independently).
+    #[test]
+    fn a_rider_is_disconnected_exactly_when_its_supports_all_move(p in params(), pick in any::<prop::sample::Index>()) {
+        let mut s = walk(&p, &|_, _, _| true);
+        let walkers: Vec<&ModuleSpec> = s.modules.iter().filter(|m| !m.fixed).collect();
+        let host = walkers[pick.index(walkers.len())].cell;
+        let l = FccLattice;
+        let rider_cell = l.neighbour(host, 4); // straight up-and-over, layer 2
+        s.modules.push(ModuleSpec { id: 10_000, cell: rider_cell, fixed: false });
+
+        let cells = cells_per_step(&s);
+        let mut expected = BTreeSet::new();
+        for (k, st) in s.steps.iter().enumerate() {
+            let moving: BTreeSet<u32> = st.events.iter().map(Event::module).collect();
+            let held = cells[k].iter().any(|(id, c)| {
+                *id != 10_000 && !moving.contains(id) && l.are_neighbours(*c, rider_cell)
+            });
+            if !held {
+                expected.insert(k + 1);
+            }
+        }
+        let last = cells.last().unwrap();
+        if !last.iter().any(|(id, c)| *id != 10_000 && l.are_neighbours(*c, rider_cell)) {
+            expected.insert(s.steps.len() + 1);
+        }
+
+        let r = lattice_report(&s);
+        let got: BTreeSet<usize> = r.violations.iter()
+            .filter(|v| v.kind == ViolationKind::Disconnected && v.modules == vec![10_000])
+            .map(|v| v.step)
+            .collect();
+        prop_assert!(r.violations.iter().all(|v| v.kind == ViolationKind::Disconnected));
+        prop_assert_eq!(got, expected);
+    }
+
+    /// Releasing the latch between a mover and its pivot one step before the
+    /// move is caught as a detached mover at that move.
+    #[test]
+    fn a_released_latch_is_caught_at_the_next_move(p in params(), pick in any::<prop::sample::Index>()) {
+        let mut s = walk(&p, &|_, _, _| true);
+        let moves: Vec<(usize, u32, u32)> = s.steps.iter().enumerate().skip(1)
+            .flat_map(|(k, st)| st.events.iter().filter_map(move |e| match e {
+                Event::Rotate { module, pivot, .. } => Some((k, *module, *pivot)),
+                _ => None,
+            }))
+            .collect();
+        prop_assume!(!moves.is_empty());
+        let (k, module, pivot) = moves[pick.index(moves.len())];
+        s.steps[k - 1].events.push(Event::Detach { module, other: pivot });
+        let r = lattice_report(&s);
+        prop_assert!(!r.certified);
+        let first = &r.violations[0];
+        prop_assert_eq!(first.kind, ViolationKind::MoverDetached);
+        prop_assert_eq!(first.step, k + 1);
+        prop_assert_eq!(&first.modules, &vec![module, pivot]);
+    }
+}
