@@ -76,6 +76,17 @@ enum Command {
     },
     /// List the generators (algorithms) scenarios can name.
     Algorithms,
+    /// Plot modules placed per time step (seed 000 Fig. 13–16) for the
+    /// schedules of one or more scenarios, as PNG (or SVG).
+    Plot {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Chart title.
+        #[arg(long, default_value = "scaffold assembly")]
+        title: String,
+    },
 }
 
 enum Failure {
@@ -136,6 +147,18 @@ fn run(cmd: Command) -> Result<u8, Failure> {
                 write(out, &s.to_json())?;
             }
             certify_and_report(&s, &path, &report)
+        }
+        Command::Plot { scenarios, output, title } => {
+            let mut curves = Vec::new();
+            for p in &scenarios {
+                let sc = Scenario::load(p)?;
+                let s = algorithms::generate(&sc)?;
+                let v = algorithms::scaffold::plot::placed_per_step(&s);
+                eprintln!("{}: {} modules placed in {} steps", sc.name, v.iter().sum::<usize>(), v.len());
+                curves.push((sc.name.clone(), v));
+            }
+            algorithms::scaffold::plot::draw(&curves, &title, &output).map_err(Failure::Output)?;
+            Ok(0)
         }
         Command::Algorithms => {
             for g in algorithms::registry() {

@@ -240,10 +240,44 @@ impl<'a> Planner<'a> {
             let mut cells: Vec<_> = best.keys().map(|&c| FccLattice::to_skewed(c)).collect();
             cells.sort();
             eprintln!(
-                "route -> {:?} failed; reached {:?}",
+                "route -> {:?} failed; reached {}",
                 FccLattice::to_skewed(dst),
-                cells
+                cells.len()
             );
+            for k in 0..12 {
+                let pivot = l.neighbour(dst, k);
+                if !occ(pivot) {
+                    continue;
+                }
+                for f in 0..12 {
+                    let from = l.neighbour(pivot, f);
+                    let tt = l.direction_to(pivot, dst).unwrap();
+                    if self.table[f][tt].is_empty() || occ(from) {
+                        continue;
+                    }
+                    let m = Motion::Rotate {
+                        from,
+                        to: dst,
+                        pivot,
+                        route: Route::Octagonal,
+                    };
+                    let bl: Vec<_> = self
+                        .rules
+                        .blocking_cells(&m)
+                        .into_iter()
+                        .filter(|&c| occ(c))
+                        .map(FccLattice::to_skewed)
+                        .collect();
+                    eprintln!(
+                        "  entry via {:?} from {:?} (reached {}, in bounds {}): blocked by {:?}",
+                        FccLattice::to_skewed(pivot),
+                        FccLattice::to_skewed(from),
+                        best.contains_key(&from),
+                        self.in_bounds(from),
+                        bl
+                    );
+                }
+            }
         }
         None
     }

@@ -181,16 +181,8 @@ impl Scaffold {
                 shape.describe()
             )));
         }
-        let below_ground = (lo.z.min(0)..0).any(|z| {
-            (lo.x - 1..=hi.x + 1)
-                .any(|x| (lo.y - 1..=hi.y + 1).any(|y| shape.contains(Skew::new(x, y, z))))
-        });
-        if below_ground {
-            return Err(InputError::new(format!(
-                "{} extends below the ground (z < 0), where the sandbox is",
-                shape.describe()
-            )));
-        }
+        // The scene is the half-space z ≥ 0 above the sandbox: parts of a
+        // shape below the ground (a sphere's lower half) are not built.
         let is_tile = |r: Skew| tiles.contains_key(&r);
         let roots: Vec<Skew> = tiles.keys().copied().collect();
         let mut info: BTreeMap<Skew, Tile> = BTreeMap::new();
