@@ -119,6 +119,13 @@ fn survey() {
 }
 
 #[test]
+fn the_fig9_cube_certifies_clean_with_the_papers_module_count() {
+    let s = certify_clean(ShapeSpec::Cube { h: 4, e: 3 });
+    assert_eq!(s.meta["scaffold_modules"], 1426);
+    eprintln!("cube h4 e3: {} steps", s.steps.len());
+}
+
+#[test]
 fn every_module_enters_at_a_source_then_only_rotates() {
     use reconfcheck::schedule::Event;
     let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 3 }, 6).unwrap();

@@ -33,28 +33,58 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Conservative stand-in for the FCC motion rules until the geometry layer
-/// derives them (`geometry::motion_rules`): a rotation needs empty every
-/// common neighbour of its start and target cells except the pivot (the
-/// mover sweeps between them), and the cells opposite the pivot through
-/// the start and through the target (seed 000's bridging constraint: no
-/// entry to, or exit from, a cell between two opposite modules).
+/// derives them (`geometry::motion_rules`). A 60° rotation needs empty the
+/// cell opposite the pivot across the start–target edge and, of the two
+/// other cells next to both start and target, the one on the side its
+/// route passes (towards the hexagonal or octagonal axis); a 90° rotation
+/// needs empty every cell next to both start and target but the pivot.
+/// Both need empty the cells opposite the pivot through the start and
+/// through the target (seed 000's bridging constraint: no entry to, or
+/// exit from, a cell between two opposite modules).
 #[derive(Debug, Default)]
 pub struct ProvisionalRules;
 
 impl MotionRules for ProvisionalRules {
     fn blocking_cells(&self, motion: &Motion) -> Vec<Cell> {
         let Motion::Rotate {
-            from, to, pivot, ..
+            from,
+            to,
+            pivot,
+            route,
         } = *motion
         else {
             return Vec::new();
         };
         let l = FccLattice;
-        let mut out: Vec<Cell> = l
+        let p = l.centre(pivot);
+        let (n_f, n_t) = (
+            (l.centre(from) - p).normalize(),
+            (l.centre(to) - p).normalize(),
+        );
+        let common = l
             .neighbours(from)
             .into_iter()
-            .filter(|&c| c != pivot && c != to && l.are_neighbours(c, to))
-            .collect();
+            .filter(|&c| c != pivot && c != to && l.are_neighbours(c, to));
+        let sixty = n_f.dot(n_t) > 0.25;
+        let mut out: Vec<Cell> = if sixty {
+            // Around the edge start–target: the cell opposite the pivot,
+            // and the one of the two side cells the route passes by.
+            let axis = fcc::rotation_axis(n_f, n_t, route).unwrap_or(n_f + n_t);
+            let mut side: Vec<Cell> = Vec::new();
+            let mut best: Option<(f64, Cell)> = None;
+            for c in common {
+                let v = l.centre(c) - p;
+                if (v.length() - 3f64.sqrt()).abs() < 1e-6 {
+                    side.push(c); // opposite the pivot across the edge
+                } else if best.is_none_or(|(d, _)| v.dot(axis) > d) {
+                    best = Some((v.dot(axis), c));
+                }
+            }
+            side.extend(best.map(|(_, c)| c));
+            side
+        } else {
+            common.collect()
+        };
         for (cell, k) in [
             (to, l.direction_to(pivot, to)),
             (from, l.direction_to(pivot, from)),
@@ -233,49 +263,6 @@ impl<'a> Planner<'a> {
                     };
                     best.insert(to, (ng, Some((c, Hop { to, pivot, route }))));
                     open.push(Reverse((ng as u64 * 1024 + h(to), ng, to)));
-                }
-            }
-        }
-        if std::env::var("SCAFFOLD_DEBUG").is_ok() {
-            let mut cells: Vec<_> = best.keys().map(|&c| FccLattice::to_skewed(c)).collect();
-            cells.sort();
-            eprintln!(
-                "route -> {:?} failed; reached {}",
-                FccLattice::to_skewed(dst),
-                cells.len()
-            );
-            for k in 0..12 {
-                let pivot = l.neighbour(dst, k);
-                if !occ(pivot) {
-                    continue;
-                }
-                for f in 0..12 {
-                    let from = l.neighbour(pivot, f);
-                    let tt = l.direction_to(pivot, dst).unwrap();
-                    if self.table[f][tt].is_empty() || occ(from) {
-                        continue;
-                    }
-                    let m = Motion::Rotate {
-                        from,
-                        to: dst,
-                        pivot,
-                        route: Route::Octagonal,
-                    };
-                    let bl: Vec<_> = self
-                        .rules
-                        .blocking_cells(&m)
-                        .into_iter()
-                        .filter(|&c| occ(c))
-                        .map(FccLattice::to_skewed)
-                        .collect();
-                    eprintln!(
-                        "  entry via {:?} from {:?} (reached {}, in bounds {}): blocked by {:?}",
-                        FccLattice::to_skewed(pivot),
-                        FccLattice::to_skewed(from),
-                        best.contains_key(&from),
-                        self.in_bounds(from),
-                        bl
-                    );
                 }
             }
         }

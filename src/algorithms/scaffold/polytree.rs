@@ -19,7 +19,7 @@
 //! * upward branches start after every horizontal branch of the tile is
 //!   complete (rule 3) and grow outwards.
 
-use super::scaffold::Scaffold;
+use super::scaffold::{Dir, Scaffold};
 use super::shape::Skew;
 use std::collections::BTreeMap;
 
@@ -66,9 +66,38 @@ impl Polytree {
             // A first branch module lies between two supports (X1 between
             // S_Z and S_RZ): it goes in before them (bridging constraint).
             let firsts = early.clone();
+            // An upward branch with no support under it (its tile has no
+            // ingoing branch of the mirror direction, at a border) has no
+            // pivots for a climb from below once its neighbours are built:
+            // it grows right after the first modules, before anything
+            // else of the tile hems it in.
+            let unsupported: Vec<(Dir, u32)> = t
+                .branches
+                .iter()
+                .copied()
+                .filter(|(d, _)| {
+                    d.is_upward() && t.layer > 0 && !t.ingoing_up.contains(&d.mirror())
+                })
+                .collect();
+            let mut lone_prev: Option<usize> = None;
+            for &(d, len) in &unsupported {
+                for m in 1..=len as i32 {
+                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    preds[c] = if m == 1 {
+                        let mut p = firsts.clone();
+                        p.extend(lone_prev);
+                        p
+                    } else {
+                        vec![idx(r.add(d.step().scale(m - 1))).expect("previous")]
+                    };
+                }
+                let tip = idx(r.add(d.step().scale(len as i32))).expect("tip");
+                early.push(tip);
+                lone_prev = Some(tip);
+            }
             for &u in &t.ingoing_up {
                 let si = idx(r.add(u.mirror().support_offset())).expect("support exists");
-                preds[si] = firsts.clone();
+                preds[si] = early.clone();
                 early.push(si);
             }
             for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
@@ -79,7 +108,13 @@ impl Polytree {
                     preds[c] = p;
                 }
             }
-            for &(d, len) in t.branches.iter().filter(|(d, _)| d.is_upward()) {
+            let ups: Vec<(Dir, u32)> = t
+                .branches
+                .iter()
+                .copied()
+                .filter(|b| b.0.is_upward() && !unsupported.contains(b))
+                .collect();
+            for &(d, len) in &ups {
                 for m in 1..=len as i32 {
                     let c = idx(r.add(d.step().scale(m))).expect("branch module");
                     preds[c] = if m == 1 {
