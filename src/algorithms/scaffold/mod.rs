@@ -160,8 +160,10 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
                 )
             })
             .collect();
+        let near: Vec<(Cell, u32)> = srcs.iter().copied().filter(|s| s.1 <= 3).collect();
         let (src, at) = planner
-            .plan(next_id, &srcs, c.cell.cell(), ready)
+            .plan(next_id, &near, c.cell.cell(), ready)
+            .or_else(|_| planner.plan(next_id, &srcs, c.cell.cell(), ready))
             .map_err(|e| {
                 InputError::new(format!(
                     "{:?} of tile {:?}: {}",
@@ -187,6 +189,7 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
             "construction order is cyclic: {planned} of {n} components planned"
         )));
     }
+    sched_timing(planner.timing);
     let mut sched = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
     sched.ground = Some(Ground {
         layer: s.sandbox_layer,
@@ -280,5 +283,11 @@ impl Generator for ScaffoldAssembly {
             }
         };
         scaffold_schedule(&spec, p.b).map_err(|e| e.in_file(&scenario.path))
+    }
+}
+
+fn sched_timing(t: (f64, f64)) {
+    if std::env::var("SCAFFOLD_TIMING").is_ok() {
+        eprintln!("route search {:.2} s, timing {:.2} s", t.0, t.1);
     }
 }

@@ -141,6 +141,9 @@ pub struct Planner<'a> {
     positions: Vec<FxHashMap<Cell, ModuleId>>,
     /// Blocking cells of the rotations of each step.
     swept: Vec<FxHashSet<Cell>>,
+    /// Last step in which a cell is crossed: held by a free agent or among
+    /// a rotation's blocking cells.
+    last_use: FxHashMap<Cell, usize>,
     /// Events of each step (index = step − 1).
     pub events: Vec<Vec<Event>>,
     /// Number of modules reaching their component in each step.
@@ -148,6 +151,8 @@ pub struct Planner<'a> {
     lo: Skew,
     hi: Skew,
     min_layer: i32,
+    /// Seconds spent searching routes and following them in time.
+    pub timing: (f64, f64),
 }
 
 impl<'a> Planner<'a> {
@@ -172,11 +177,13 @@ impl<'a> Planner<'a> {
             module_at,
             positions: vec![FxHashMap::default()],
             swept: vec![FxHashSet::default()],
+            last_use: FxHashMap::default(),
             events: Vec::new(),
             placed_per_step: Vec::new(),
             lo: Skew::new(lo.x - 4, lo.y - 4, -1),
             hi: Skew::new(hi.x + 4, hi.y + 4, hi.z + 2),
             min_layer: -1,
+            timing: (0.0, 0.0),
         }
     }
 
@@ -199,7 +206,7 @@ impl<'a> Planner<'a> {
         let l = FccLattice;
         let goal = l.centre(dst);
         let h = |c: Cell| {
-            ((l.centre(c) - goal).length() / std::f64::consts::SQRT_2 * 1.5 * 1024.0) as u64
+            ((l.centre(c) - goal).length() / std::f64::consts::SQRT_2 * 2.0 * 1024.0) as u64
         };
         let mut best: FxHashMap<Cell, (u32, Option<(Cell, Hop)>)> = FxHashMap::default();
         let mut open = BinaryHeap::new();
@@ -280,7 +287,8 @@ impl<'a> Planner<'a> {
         if p.is_empty() {
             return true;
         }
-        !p.contains_key(&c) && FccLattice.neighbours(c).iter().all(|n| !p.contains_key(n))
+        let l = FccLattice;
+        !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
     }
 
     fn free_of_agents(&self, c: Cell, t: usize) -> bool {
@@ -332,9 +340,7 @@ impl<'a> Planner<'a> {
                 if ok && last {
                     // Once in place, the module must not stand in the way
                     // of rotations planned for later steps.
-                    ok = (step + 1..self.positions.len()).all(|s| {
-                        !self.swept[s].contains(&hop.to) && !self.positions[s].contains_key(&hop.to)
-                    });
+                    ok = self.last_use.get(&hop.to).is_none_or(|&u| u <= step);
                 }
                 if ok {
                     cur = hop.to;
@@ -363,7 +369,11 @@ impl<'a> Planner<'a> {
         dst: Cell,
         ready: usize,
     ) -> Result<(Cell, usize), InputError> {
-        let (src, hops) = self.route(srcs, dst).ok_or_else(|| {
+        let t_route = std::time::Instant::now();
+        let routed = self.route(srcs, dst);
+        self.timing.0 += t_route.elapsed().as_secs_f64();
+        let t_follow = std::time::Instant::now();
+        let (src, hops) = routed.ok_or_else(|| {
             InputError::new(format!(
                 "no sequence of rotations leads from any entry point to cell {dst} over the structure \
                  built so far"
@@ -377,6 +387,7 @@ impl<'a> Planner<'a> {
             }
             t0 += 1;
         };
+        self.timing.1 += t_follow.elapsed().as_secs_f64();
         let arrival = *steps.last().unwrap_or(&t0);
         while self.positions.len() <= arrival {
             self.positions.push(FxHashMap::default());
@@ -388,6 +399,8 @@ impl<'a> Planner<'a> {
         }
         for (k, &c) in cells.iter().enumerate() {
             self.positions[t0 + k].insert(c, id);
+            let u = self.last_use.entry(c).or_insert(0);
+            *u = (*u).max(t0 + k);
         }
         self.events[t0 - 1].push(Event::Enter {
             module: id,
@@ -401,7 +414,11 @@ impl<'a> Planner<'a> {
                 pivot: hop.pivot,
                 route: hop.route,
             };
-            self.swept[step].extend(self.rules.blocking_cells(&m));
+            for b in self.rules.blocking_cells(&m) {
+                self.swept[step].insert(b);
+                let u = self.last_use.entry(b).or_insert(0);
+                *u = (*u).max(step);
+            }
             let pivot = self.module_at[&hop.pivot].0;
             self.events[step - 1].push(Event::Rotate {
                 module: id,
