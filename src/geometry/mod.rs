@@ -4,6 +4,11 @@
 //! asks [`sweep_model`] for the one of the schedule's lattice and turns the
 //! contacts it reports into violations and warnings.
 
+pub mod catom;
+pub mod rolling;
+pub mod rules;
+pub mod sweep;
+
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
 use glam::DVec3;
@@ -90,6 +95,7 @@ pub trait MotionRules: Send + Sync {
 /// The motion rules of a lattice, if this build derives them.
 pub fn motion_rules(kind: LatticeKind) -> Option<&'static dyn MotionRules> {
     match kind {
-        LatticeKind::Fcc | LatticeKind::Square | LatticeKind::Cubic => None,
+        LatticeKind::Fcc => Some(&rules::FccRules),
+        LatticeKind::Square | LatticeKind::Cubic => None,
     }
 }
