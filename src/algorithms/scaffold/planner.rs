@@ -144,6 +144,12 @@ pub struct Planner<'a> {
     /// Last step in which a cell is crossed: held by a free agent or among
     /// a rotation's blocking cells.
     last_use: FxHashMap<Cell, usize>,
+    /// Rotations planned so far, by pivot cell: a module placed later must
+    /// not make any of them illegal (the rules' pinches depend on pairs of
+    /// occupied cells, not only on blocking cells).
+    moves_by_pivot: FxHashMap<Cell, Vec<(usize, Motion)>>,
+    /// Cells within 2 d of a cell (lattice offsets, both parities).
+    reach: [Vec<(i32, i32, i32)>; 2],
     /// Events of each step (index = step − 1).
     pub events: Vec<Vec<Event>>,
     /// Number of modules reaching their component in each step.
@@ -178,6 +184,23 @@ impl<'a> Planner<'a> {
             positions: vec![FxHashMap::default()],
             swept: vec![FxHashSet::default()],
             last_use: FxHashMap::default(),
+            moves_by_pivot: FxHashMap::default(),
+            reach: [0, 1].map(|parity| {
+                let l = FccLattice;
+                let o = Cell::new(0, 0, parity);
+                let mut v = Vec::new();
+                for x in -3..=3 {
+                    for y in -3..=3 {
+                        for z in -3..=3 {
+                            let c = Cell::new(x, y, parity + z);
+                            if (l.centre(c) - l.centre(o)).length() < 2.0 + 1e-9 {
+                                v.push((x, y, z));
+                            }
+                        }
+                    }
+                }
+                v
+            }),
             events: Vec::new(),
             placed_per_step: Vec::new(),
             lo: Skew::new(lo.x - 4, lo.y - 4, -1),
@@ -291,6 +314,26 @@ impl<'a> Planner<'a> {
         !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
     }
 
+    /// Whether a module arriving at `c` at the end of `step` leaves every
+    /// later planned rotation allowed by the rules.
+    fn keeps_later_moves_legal(&self, c: Cell, step: usize) -> bool {
+        let par = c.z.rem_euclid(2) as usize;
+        for &(x, y, z) in &self.reach[par] {
+            let p = Cell::new(c.x + x, c.y + y, c.z + z);
+            let Some(moves) = self.moves_by_pivot.get(&p) else {
+                continue;
+            };
+            for (s, m) in moves.iter().filter(|(s, _)| *s > step) {
+                let occ =
+                    |q: Cell| q == c || self.module_at.get(&q).is_some_and(|&(_, at)| at < *s);
+                if !self.rules.allows(m, &occ) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     fn free_of_agents(&self, c: Cell, t: usize) -> bool {
         t >= self.positions.len() || !self.positions[t].contains_key(&c)
     }
@@ -331,16 +374,20 @@ impl<'a> Planner<'a> {
                         pivot: hop.pivot,
                         route: hop.route,
                     };
-                    ok = self
-                        .rules
-                        .blocking_cells(&m)
-                        .into_iter()
-                        .all(|b| self.free_of_agents(b, t) && self.free_of_agents(b, step));
+                    // Static modules in place and free agents (before or
+                    // after the step) are all obstacles.
+                    let occ = |q: Cell| {
+                        self.module_at.get(&q).is_some_and(|&(_, at)| at < step)
+                            || !self.free_of_agents(q, t)
+                            || !self.free_of_agents(q, step)
+                    };
+                    ok = self.rules.allows(&m, &occ);
                 }
                 if ok && last {
                     // Once in place, the module must not stand in the way
                     // of rotations planned for later steps.
-                    ok = self.last_use.get(&hop.to).is_none_or(|&u| u <= step);
+                    ok = self.last_use.get(&hop.to).is_none_or(|&u| u <= step)
+                        && self.keeps_later_moves_legal(hop.to, step);
                 }
                 if ok {
                     cur = hop.to;
@@ -414,6 +461,10 @@ impl<'a> Planner<'a> {
                 pivot: hop.pivot,
                 route: hop.route,
             };
+            self.moves_by_pivot
+                .entry(hop.pivot)
+                .or_default()
+                .push((step, m.clone()));
             for b in self.rules.blocking_cells(&m) {
                 self.swept[step].insert(b);
                 let u = self.last_use.entry(b).or_insert(0);
