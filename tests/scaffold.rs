@@ -15,13 +15,8 @@ fn certify_clean(shape: ShapeSpec) -> reconfcheck::schedule::Schedule {
 }
 
 #[test]
-fn pyramid_h2_certifies_clean() {
-    let s = certify_clean(ShapeSpec::Pyramid { h: 2 });
-    eprintln!("h2: {} steps", s.steps.len());
-}
-
-#[test]
-fn pyramids_h3_h4_certify_clean() {
+fn pyramids_h3_h4_certify_clean_in_time_linear_in_h() {
+    let mut steps = vec![certify_clean(ShapeSpec::Pyramid { h: 2 }).steps.len()];
     for h in 3..=4 {
         let s = certify_clean(ShapeSpec::Pyramid { h });
         eprintln!(
@@ -29,7 +24,14 @@ fn pyramids_h3_h4_certify_clean() {
             s.steps.len(),
             s.move_count()
         );
+        steps.push(s.steps.len());
     }
+    // Seed 000 Eq. (6): T grows by a constant per tile layer (80 for b = 6).
+    let (d1, d2) = ((steps[1] - steps[0]) as f64, (steps[2] - steps[1]) as f64);
+    assert!(
+        (d2 / d1 - 1.0).abs() < 0.25,
+        "per-layer increments {d1} and {d2}"
+    );
 }
 
 /// Module counts of the bundled shapes (a study: `cargo test --test
@@ -189,4 +191,48 @@ fn placement_curve_counts_every_module_once() {
     let out = std::env::temp_dir().join(format!("scaffold-plot-{}.png", std::process::id()));
     reconfcheck::algorithms::scaffold::plot::draw(&[("h2".into(), v)], "pyramid", &out).unwrap();
     assert!(std::fs::metadata(&out).unwrap().len() > 1000);
+}
+
+/// Reconfiguration time of h-pyramids against seed 000 Eq. (6) (a study:
+/// `cargo test --release --test scaffold pyramid_time_study -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn pyramid_time_study() {
+    let hmax: u32 = std::env::var("HMAX")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(8);
+    for h in 2..=hmax {
+        let t = std::time::Instant::now();
+        let s = scaffold_schedule(&ShapeSpec::Pyramid { h }, 6).unwrap();
+        eprintln!(
+            "h = {h}: {} modules, {} steps (paper T = 16(b-1)(h-1) = {}), generated in {:?}",
+            s.meta["scaffold_modules"],
+            s.steps.len(),
+            80 * (h - 1),
+            t.elapsed()
+        );
+    }
+}
+
+#[test]
+fn the_plot_command_writes_a_png_of_a_scenario() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("scaffold-cli-plot-{}.png", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+        .arg("plot")
+        .arg(root.join("scenarios/pyramid-h3-b6.toml"))
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("250 modules placed"));
+    let png = std::fs::read(&out).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
 }

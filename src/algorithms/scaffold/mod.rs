@@ -189,7 +189,7 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
             "construction order is cyclic: {planned} of {n} components planned"
         )));
     }
-    sched_timing(planner.timing);
+    report_timing(planner.timing);
     let mut sched = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
     sched.ground = Some(Ground {
         layer: s.sandbox_layer,
@@ -286,7 +286,7 @@ impl Generator for ScaffoldAssembly {
     }
 }
 
-fn sched_timing(t: (f64, f64)) {
+fn report_timing(t: (f64, f64)) {
     if std::env::var("SCAFFOLD_TIMING").is_ok() {
         eprintln!("route search {:.2} s, timing {:.2} s", t.0, t.1);
     }
