@@ -40,12 +40,11 @@ pub enum ShapeSpec {
     Csg { path: PathBuf },
 }
 
-/// Rules the planner uses: the geometry layer's FCC motion rules where
-/// this build derives them, otherwise the conservative
-/// [`planner::ProvisionalRules`].
-pub fn motion_rules() -> &'static dyn MotionRules {
-    static PROVISIONAL: planner::ProvisionalRules = planner::ProvisionalRules;
-    crate::geometry::motion_rules(LatticeKind::Fcc).unwrap_or(&PROVISIONAL)
+/// Rules the planner uses: the FCC motion rules the geometry layer derives
+/// from the exact catom body (SPEC §4.4).
+pub fn motion_rules() -> Result<&'static dyn MotionRules, InputError> {
+    crate::geometry::motion_rules(LatticeKind::Fcc)
+        .ok_or_else(|| InputError::new("this build derives no FCC motion rules to plan with"))
 }
 
 /// The scaffold of a shape with branch length `b`.
@@ -89,7 +88,7 @@ pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError>
 /// scaffold cell).
 pub fn scaffold_schedule(shape: &ShapeSpec, b: u32) -> Result<Schedule, InputError> {
     let s = build_scaffold(shape, b)?;
-    let mut sched = schedule_for(&s, motion_rules())?;
+    let mut sched = schedule_for(&s, motion_rules()?)?;
     sched
         .meta
         .insert("shape".into(), format!("{shape:?}").into());

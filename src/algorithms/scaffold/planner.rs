@@ -32,71 +32,6 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-/// Conservative stand-in for the FCC motion rules until the geometry layer
-/// derives them (`geometry::motion_rules`). A 60° rotation needs empty the
-/// cell opposite the pivot across the start–target edge and, of the two
-/// other cells next to both start and target, the one on the side its
-/// route passes (towards the hexagonal or octagonal axis); a 90° rotation
-/// needs empty every cell next to both start and target but the pivot.
-/// Both need empty the cells opposite the pivot through the start and
-/// through the target (seed 000's bridging constraint: no entry to, or
-/// exit from, a cell between two opposite modules).
-#[derive(Debug, Default)]
-pub struct ProvisionalRules;
-
-impl MotionRules for ProvisionalRules {
-    fn blocking_cells(&self, motion: &Motion) -> Vec<Cell> {
-        let Motion::Rotate {
-            from,
-            to,
-            pivot,
-            route,
-        } = *motion
-        else {
-            return Vec::new();
-        };
-        let l = FccLattice;
-        let p = l.centre(pivot);
-        let (n_f, n_t) = (
-            (l.centre(from) - p).normalize(),
-            (l.centre(to) - p).normalize(),
-        );
-        let common = l
-            .neighbours(from)
-            .into_iter()
-            .filter(|&c| c != pivot && c != to && l.are_neighbours(c, to));
-        let sixty = n_f.dot(n_t) > 0.25;
-        let mut out: Vec<Cell> = if sixty {
-            // Around the edge start–target: the cell opposite the pivot,
-            // and the one of the two side cells the route passes by.
-            let axis = fcc::rotation_axis(n_f, n_t, route).unwrap_or(n_f + n_t);
-            let mut side: Vec<Cell> = Vec::new();
-            let mut best: Option<(f64, Cell)> = None;
-            for c in common {
-                let v = l.centre(c) - p;
-                if (v.length() - 3f64.sqrt()).abs() < 1e-6 {
-                    side.push(c); // opposite the pivot across the edge
-                } else if best.is_none_or(|(d, _)| v.dot(axis) > d) {
-                    best = Some((v.dot(axis), c));
-                }
-            }
-            side.extend(best.map(|(_, c)| c));
-            side
-        } else {
-            common.collect()
-        };
-        for (cell, k) in [
-            (to, l.direction_to(pivot, to)),
-            (from, l.direction_to(pivot, from)),
-        ] {
-            if let Some(k) = k {
-                out.push(l.neighbour(cell, k));
-            }
-        }
-        out
-    }
-}
-
 /// Rotation links of a pivot: for connector `f` (pivot → mover), the
 /// connectors `t` reachable in one rotation and their routes (SPEC §3).
 fn rotation_table() -> [[&'static [Route]; 12]; 12] {
@@ -490,27 +425,6 @@ impl<'a> Planner<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn provisional_rules_encode_the_bridging_constraint() {
-        let l = FccLattice;
-        // Entering the gap of a line x = 0, _, 2 from above, pivoting on x = 0.
-        let p = Cell::new(0, 0, 0);
-        let from = l.neighbour(p, 4);
-        let to = Cell::new(1, 0, 0);
-        let m = Motion::Rotate {
-            from,
-            to,
-            pivot: p,
-            route: Route::Octagonal,
-        };
-        assert!(l.move_requirements(&m).is_ok());
-        let r = ProvisionalRules;
-        let line_end = Cell::new(2, 0, 0);
-        assert!(r.blocking_cells(&m).contains(&line_end));
-        assert!(!r.allows(&m, &|c| c == line_end || c == p));
-        assert!(r.allows(&m, &|c| c == p));
-    }
 
     #[test]
     fn every_pivot_offers_48_hexagonal_and_72_octagonal_links() {
