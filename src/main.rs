@@ -80,6 +80,17 @@ enum Command {
     },
     /// List the generators (algorithms) scenarios can name.
     Algorithms,
+    /// Plot modules placed per time step (seed 000 Fig. 13–16) for the
+    /// schedules of one or more scenarios, as PNG (or SVG).
+    Plot {
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Chart title.
+        #[arg(long, default_value = "scaffold assembly")]
+        title: String,
+    },
     /// Branch-length study: check every step of a shape family for a range
     /// of b; table on stdout, plot of utilisation and minimum pressure.
     BStudy {
@@ -322,6 +333,27 @@ fn run(cmd: Command) -> Result<u8, Failure> {
                 },
             )?;
             println!("{summary}");
+            Ok(0)
+        }
+        Command::Plot {
+            scenarios,
+            output,
+            title,
+        } => {
+            let mut curves = Vec::new();
+            for p in &scenarios {
+                let sc = Scenario::load(p)?;
+                let s = algorithms::generate(&sc)?;
+                let v = algorithms::scaffold::plot::placed_per_step(&s);
+                eprintln!(
+                    "{}: {} modules placed in {} steps",
+                    sc.name,
+                    v.iter().sum::<usize>(),
+                    v.len()
+                );
+                curves.push((sc.name.clone(), v));
+            }
+            algorithms::scaffold::plot::draw(&curves, &title, &output).map_err(Failure::Output)?;
             Ok(0)
         }
         Command::Algorithms => {

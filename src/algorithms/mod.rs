@@ -7,6 +7,7 @@
 pub mod active_subtraction;
 pub mod branch;
 pub mod random_walk;
+pub mod scaffold;
 pub mod schedule_file;
 
 use crate::error::InputError;
@@ -30,6 +31,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &random_walk::RandomWalk,
         &active_subtraction::ActiveSubtraction,
         &branch::Branch,
+        &scaffold::ScaffoldAssembly,
     ]
 }
 

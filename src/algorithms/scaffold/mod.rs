@@ -1,0 +1,292 @@
+//! Seed 000: deterministic scaffold assembly from a sandbox (Thalamy et
+//! al.), as a generator of real per-step rotations.
+//!
+//! * [`shape`] / [`csg`] — goal shapes (h-pyramids, cubes, CSG files);
+//! * [`scaffold`] — tiles, branches, supports, sandbox, entry points;
+//! * [`polytree`] — the construction order;
+//! * [`planner`] — motion of every module from the sandbox to its cell;
+//! * [`plot`] — modules-placed-per-step curves (seed 000 Fig. 13–16).
+//!
+//! See `docs/scaffold.md`.
+
+pub mod csg;
+pub mod planner;
+pub mod plot;
+pub mod polytree;
+#[allow(clippy::module_inception)]
+pub mod scaffold;
+pub mod shape;
+
+use super::{Generator, parameters};
+use crate::error::InputError;
+use crate::geometry::MotionRules;
+use crate::lattice::config::{Ground, ModuleId};
+use crate::lattice::{Cell, LatticeKind};
+use crate::scenario::Scenario;
+use crate::schedule::{Length, ModuleSpec, Schedule, Step};
+use scaffold::Scaffold;
+use serde::Deserialize;
+use shape::{CubeShape, Pyramid, Shape, Skew};
+use std::path::PathBuf;
+
+/// A goal shape, as the library API and scenarios name it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeSpec {
+    /// Seed 000 §4's h-pyramid (h tiles wide at the base, h tile layers).
+    Pyramid { h: u32 },
+    /// Seed 000 §5.3.1's cube of side `(h − 1)·b + e` modules.
+    Cube { h: u32, e: u32 },
+    /// A CSG file (see [`csg`]).
+    Csg { path: PathBuf },
+}
+
+/// Rules the planner uses: the FCC motion rules the geometry layer derives
+/// from the exact catom body (SPEC §4.4).
+pub fn motion_rules() -> Result<&'static dyn MotionRules, InputError> {
+    crate::geometry::motion_rules(LatticeKind::Fcc)
+        .ok_or_else(|| InputError::new("this build derives no FCC motion rules to plan with"))
+}
+
+/// The scaffold of a shape with branch length `b`.
+pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError> {
+    let bi = b as i32;
+    match shape {
+        ShapeSpec::Pyramid { h } => {
+            if *h < 1 {
+                return Err(InputError::new("a pyramid needs h ≥ 1"));
+            }
+            let top = (*h as i32 - 1) * bi;
+            Scaffold::build(
+                &Pyramid { h: *h, b },
+                b,
+                (Skew::new(0, 0, 0), Skew::new(top, top, top)),
+            )
+        }
+        ShapeSpec::Cube { h, e } => {
+            if *h < 1 || *e < 1 || *e > b {
+                return Err(InputError::new(format!(
+                    "a cube needs h ≥ 1 and 1 ≤ e ≤ b (got h = {h}, e = {e}, b = {b})"
+                )));
+            }
+            let l = (*h as i32 - 1) * bi + *e as i32;
+            Scaffold::build(
+                &CubeShape { l },
+                b,
+                (Skew::new(-l, -l, 0), Skew::new(l, l, l)),
+            )
+        }
+        ShapeSpec::Csg { path } => {
+            let s = csg::CsgShape::load(path)?;
+            let bounds = s.skew_bounds();
+            Scaffold::build(&s as &dyn Shape, b, bounds).map_err(|e| e.in_file(path))
+        }
+    }
+}
+
+/// Generates the schedule that assembles `shape`'s scaffold with branch
+/// length `b` from the sandbox (No-Surplus variant: exactly one module per
+/// scaffold cell).
+pub fn scaffold_schedule(shape: &ShapeSpec, b: u32) -> Result<Schedule, InputError> {
+    let s = build_scaffold(shape, b)?;
+    let mut sched = schedule_for(&s, motion_rules()?)?;
+    sched
+        .meta
+        .insert("shape".into(), format!("{shape:?}").into());
+    Ok(sched)
+}
+
+/// Plans every module of a scaffold and writes the schedule.
+pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, InputError> {
+    let tree = polytree::Polytree::build(s);
+    let n = s.components.len();
+    let mut succ = vec![Vec::new(); n];
+    let mut missing: Vec<usize> = tree.preds.iter().map(Vec::len).collect();
+    for (i, ps) in tree.preds.iter().enumerate() {
+        for &p in ps {
+            succ[p].push(i);
+        }
+    }
+    let rank: Vec<usize> = {
+        let mut r = vec![0; n];
+        for (k, i) in tree.topological().into_iter().enumerate() {
+            r[i] = k;
+        }
+        r
+    };
+    let mut ready_at = vec![0usize; n];
+    let mut open: std::collections::BinaryHeap<std::cmp::Reverse<(usize, usize, usize)>> = (0..n)
+        .filter(|&i| missing[i] == 0)
+        .map(|i| std::cmp::Reverse((0, rank[i], i)))
+        .collect();
+    let mut planner = planner::Planner::new(s, rules);
+    let mut next_id = s.sandbox.len() as ModuleId;
+    let mut sources = std::collections::BTreeSet::new();
+    let all_sources: Vec<(Skew, Cell)> = s
+        .tiles
+        .iter()
+        .filter(|(_, t)| t.layer == 0)
+        .flat_map(|(&g, _)| scaffold::Dir::UPWARD.map(|u| (g, s.source(g, u).cell())))
+        .collect();
+    let mut planned = 0;
+    while let Some(std::cmp::Reverse((ready, _, i))) = open.pop() {
+        let c = &s.components[i];
+        // The entry point of the feeding chain first (§3.3.2); the others
+        // of its ground tile, then any, at a penalty: an entry point hemmed
+        // in by finished branches cannot send modules anywhere.
+        let preferred = s.source_for(c);
+        let ground = preferred.add(scaffold::Dir::Z.epl_offset().scale(-1));
+        let ground = all_sources
+            .iter()
+            .map(|&(g, _)| g)
+            .find(|g| {
+                scaffold::Dir::UPWARD
+                    .iter()
+                    .any(|&u| s.source(*g, u) == preferred)
+            })
+            .unwrap_or(ground);
+        let srcs: Vec<(Cell, u32)> = all_sources
+            .iter()
+            .map(|&(g, cell)| {
+                (
+                    cell,
+                    if cell == preferred.cell() {
+                        0
+                    } else if g == ground {
+                        3
+                    } else {
+                        8
+                    },
+                )
+            })
+            .collect();
+        let near: Vec<(Cell, u32)> = srcs.iter().copied().filter(|s| s.1 <= 3).collect();
+        let (src, at) = planner
+            .plan(next_id, &near, c.cell.cell(), ready)
+            .or_else(|_| planner.plan(next_id, &srcs, c.cell.cell(), ready))
+            .map_err(|e| {
+                InputError::new(format!(
+                    "{:?} of tile {:?}: {}",
+                    c.part,
+                    (c.tile.x, c.tile.y, c.tile.z),
+                    e.message
+                ))
+                .for_module(next_id)
+            })?;
+        sources.insert(src);
+        next_id += 1;
+        planned += 1;
+        for &j in &succ[i] {
+            ready_at[j] = ready_at[j].max(at);
+            missing[j] -= 1;
+            if missing[j] == 0 {
+                open.push(std::cmp::Reverse((ready_at[j], rank[j], j)));
+            }
+        }
+    }
+    if planned != n {
+        return Err(InputError::new(format!(
+            "construction order is cyclic: {planned} of {n} components planned"
+        )));
+    }
+    report_timing(planner.timing);
+    let mut sched = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+    sched.ground = Some(Ground {
+        layer: s.sandbox_layer,
+    });
+    sched.modules = s
+        .sandbox
+        .iter()
+        .enumerate()
+        .map(|(i, c)| ModuleSpec {
+            id: i as ModuleId,
+            cell: c.cell(),
+            fixed: true,
+        })
+        .collect();
+    sched.sources = sources.into_iter().collect();
+    sched.steps = planner
+        .events
+        .into_iter()
+        .map(|mut events| {
+            events.sort_by_key(|e| e.module());
+            Step { events }
+        })
+        .collect();
+    sched.meta.insert("algorithm".into(), "scaffold".into());
+    sched.meta.insert("b".into(), s.b.into());
+    sched.meta.insert("tiles".into(), s.tiles.len().into());
+    sched.meta.insert("scaffold_modules".into(), n.into());
+    sched
+        .meta
+        .insert("sandbox_modules".into(), s.sandbox.len().into());
+    Ok(sched)
+}
+
+/// Scenario parameters of the `scaffold` generator.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Params {
+    /// "pyramid", "cube" or "csg".
+    shape: String,
+    #[serde(default)]
+    h: Option<u32>,
+    #[serde(default)]
+    e: Option<u32>,
+    #[serde(default = "default_b")]
+    b: u32,
+    /// CSG file, relative to the scenario (with `shape = "csg"`).
+    #[serde(default)]
+    csg: Option<String>,
+}
+
+fn default_b() -> u32 {
+    6
+}
+
+/// The `scaffold` generator (seed 000).
+pub struct ScaffoldAssembly;
+
+impl Generator for ScaffoldAssembly {
+    fn name(&self) -> &'static str {
+        "scaffold"
+    }
+
+    fn about(&self) -> &'static str {
+        "seed 000: scaffold assembly from a sandbox (pyramids, cubes, semi-convex CSG shapes)"
+    }
+
+    fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
+        let p: Params = parameters(scenario)?;
+        let need = |v: Option<u32>, what: &str| {
+            v.ok_or_else(|| scenario.error(format!("shape '{}' needs parameter {what}", p.shape)))
+        };
+        let spec = match p.shape.as_str() {
+            "pyramid" => ShapeSpec::Pyramid { h: need(p.h, "h")? },
+            "cube" => ShapeSpec::Cube {
+                h: need(p.h, "h")?,
+                e: p.e.unwrap_or(p.b),
+            },
+            "csg" => {
+                let rel = p
+                    .csg
+                    .clone()
+                    .ok_or_else(|| scenario.error("shape 'csg' needs parameter csg (a file)"))?;
+                ShapeSpec::Csg {
+                    path: scenario.resolve(&rel),
+                }
+            }
+            other => {
+                return Err(scenario.error(format!(
+                    "unknown shape '{other}' (known: pyramid, cube, csg)"
+                )));
+            }
+        };
+        scaffold_schedule(&spec, p.b).map_err(|e| e.in_file(&scenario.path))
+    }
+}
+
+fn report_timing(t: (f64, f64)) {
+    if std::env::var("SCAFFOLD_TIMING").is_ok() {
+        eprintln!("route search {:.2} s, timing {:.2} s", t.0, t.1);
+    }
+}

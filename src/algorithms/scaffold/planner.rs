@@ -1,0 +1,444 @@
+//! Motion planning (seed 000 §3.3.3–3.3.4), centralised.
+//!
+//! Every module enters at a sandbox entry point and rolls, one rotation per
+//! time step, to its component. Modules are planned one at a time, in
+//! order of the time their component becomes buildable (polytree
+//! precedences), with prioritised space–time planning:
+//!
+//! 1. a static route is searched (A*) over the structure the earlier
+//!    modules leave behind, with every rotation accepted by the lattice's
+//!    geometry-derived [`MotionRules`] (blocking cells empty);
+//! 2. the module then follows that route in time against the trajectories
+//!    of the modules already planned: it waits while a pivot is not yet in
+//!    place, while its component's predecessors are not yet in place, or
+//!    while moving would break the gap that §3.3.4's light protocol keeps
+//!    between free agents (no two free agents in neighbouring cells, before
+//!    or after any step, and nobody inside another mover's blocking cells);
+//! 3. if waiting is impossible (another module comes by), its departure
+//!    is delayed by one step and it tries again. Departing after every
+//!    earlier module has arrived always succeeds, so planning terminates.
+//!
+//! This replaces the paper's hand-written local rules and green-light
+//! handshake by a search that imposes the same invariants.
+
+use super::scaffold::Scaffold;
+use super::shape::Skew;
+use crate::error::InputError;
+use crate::geometry::MotionRules;
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Cell, FccLattice, Lattice, Motion, Route, fcc};
+use crate::schedule::Event;
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Rotation links of a pivot: for connector `f` (pivot → mover), the
+/// connectors `t` reachable in one rotation and their routes (SPEC §3).
+fn rotation_table() -> [[&'static [Route]; 12]; 12] {
+    const SIXTY: &[Route] = &[Route::Octagonal, Route::Hexagonal];
+    const NINETY: &[Route] = &[Route::Octagonal];
+    const NONE: &[Route] = &[];
+    let mut t = [[NONE; 12]; 12];
+    for f in 0..12 {
+        for g in 0..12 {
+            let dot = fcc::direction(f).dot(fcc::direction(g));
+            t[f][g] = if (dot - 0.5).abs() < 1e-9 {
+                SIXTY
+            } else if dot.abs() < 1e-9 {
+                NINETY
+            } else {
+                NONE
+            };
+        }
+    }
+    t
+}
+
+/// One rotation of a route: target cell, pivot cell, route.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Hop {
+    pub to: Cell,
+    pub pivot: Cell,
+    pub route: Route,
+}
+
+/// The planner's state: the static structure and the space–time
+/// reservations of every module planned so far.
+pub struct Planner<'a> {
+    rules: &'a dyn MotionRules,
+    table: [[&'static [Route]; 12]; 12],
+    /// Cells holding a static module once everything planned is in place.
+    occupied: FxHashSet<Cell>,
+    /// Module of each static cell, and the step at the end of which it is
+    /// in place (0 for the sandbox).
+    module_at: FxHashMap<Cell, (ModuleId, usize)>,
+    /// Free agents' cells at the end of each step (index = step).
+    positions: Vec<FxHashMap<Cell, ModuleId>>,
+    /// Blocking cells of the rotations of each step.
+    swept: Vec<FxHashSet<Cell>>,
+    /// Last step in which a cell is crossed: held by a free agent or among
+    /// a rotation's blocking cells.
+    last_use: FxHashMap<Cell, usize>,
+    /// Rotations planned so far, by pivot cell: a module placed later must
+    /// not make any of them illegal (the rules' pinches depend on pairs of
+    /// occupied cells, not only on blocking cells).
+    moves_by_pivot: FxHashMap<Cell, Vec<(usize, Motion)>>,
+    /// Cells within 2 d of a cell (lattice offsets, both parities).
+    reach: [Vec<(i32, i32, i32)>; 2],
+    /// Events of each step (index = step − 1).
+    pub events: Vec<Vec<Event>>,
+    /// Number of modules reaching their component in each step.
+    pub placed_per_step: Vec<usize>,
+    lo: Skew,
+    hi: Skew,
+    min_layer: i32,
+    /// Seconds spent searching routes and following them in time.
+    pub timing: (f64, f64),
+}
+
+impl<'a> Planner<'a> {
+    /// A planner over `scaffold`'s sandbox (module ids `0..sandbox.len()`).
+    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules) -> Planner<'a> {
+        let mut occupied = FxHashSet::default();
+        let mut module_at = FxHashMap::default();
+        for (i, s) in scaffold.sandbox.iter().enumerate() {
+            occupied.insert(s.cell());
+            module_at.insert(s.cell(), (i as ModuleId, 0));
+        }
+        let mut lo = Skew::new(i32::MAX, i32::MAX, i32::MAX);
+        let mut hi = Skew::new(i32::MIN, i32::MIN, i32::MIN);
+        for c in scaffold.components.iter().map(|c| c.cell) {
+            lo = Skew::new(lo.x.min(c.x), lo.y.min(c.y), lo.z.min(c.z));
+            hi = Skew::new(hi.x.max(c.x), hi.y.max(c.y), hi.z.max(c.z));
+        }
+        Planner {
+            rules,
+            table: rotation_table(),
+            occupied,
+            module_at,
+            positions: vec![FxHashMap::default()],
+            swept: vec![FxHashSet::default()],
+            last_use: FxHashMap::default(),
+            moves_by_pivot: FxHashMap::default(),
+            reach: [0, 1].map(|parity| {
+                let l = FccLattice;
+                let o = Cell::new(0, 0, parity);
+                let mut v = Vec::new();
+                for x in -3..=3 {
+                    for y in -3..=3 {
+                        for z in -3..=3 {
+                            let c = Cell::new(x, y, parity + z);
+                            if (l.centre(c) - l.centre(o)).length() < 2.0 + 1e-9 {
+                                v.push((x, y, z));
+                            }
+                        }
+                    }
+                }
+                v
+            }),
+            events: Vec::new(),
+            placed_per_step: Vec::new(),
+            lo: Skew::new(lo.x - 4, lo.y - 4, -1),
+            hi: Skew::new(hi.x + 4, hi.y + 4, hi.z + 2),
+            min_layer: -1,
+            timing: (0.0, 0.0),
+        }
+    }
+
+    /// Last step of the schedule so far.
+    pub fn horizon(&self) -> usize {
+        self.positions.len() - 1
+    }
+
+    fn in_bounds(&self, c: Cell) -> bool {
+        let (x, y, z) = FccLattice::to_skewed(c);
+        z >= self.min_layer
+            && (self.lo.x..=self.hi.x).contains(&x)
+            && (self.lo.y..=self.hi.y).contains(&y)
+            && z <= self.hi.z
+    }
+
+    /// A* over the static structure: rotations from one of `srcs` (each
+    /// with a start penalty, in moves) to `dst`. Returns the source used.
+    pub fn route(&self, srcs: &[(Cell, u32)], dst: Cell) -> Option<(Cell, Vec<Hop>)> {
+        let l = FccLattice;
+        let goal = l.centre(dst);
+        let h = |c: Cell| {
+            ((l.centre(c) - goal).length() / std::f64::consts::SQRT_2 * 2.0 * 1024.0) as u64
+        };
+        let mut best: FxHashMap<Cell, (u32, Option<(Cell, Hop)>)> = FxHashMap::default();
+        let mut open = BinaryHeap::new();
+        for &(src, pen) in srcs {
+            if best.get(&src).is_none_or(|&(g, _)| g > pen) {
+                best.insert(src, (pen, None));
+                open.push(Reverse((pen as u64 * 1024 + h(src), pen, src)));
+            }
+        }
+        let occ = |c: Cell| self.occupied.contains(&c);
+        let mut expanded = 0usize;
+        while let Some(Reverse((_, g, c))) = open.pop() {
+            if best.get(&c).is_some_and(|&(bg, _)| bg < g) {
+                continue;
+            }
+            if c == dst {
+                let mut hops = Vec::new();
+                let mut cur = c;
+                while let Some((prev, hop)) = best[&cur].1 {
+                    hops.push(hop);
+                    cur = prev;
+                }
+                hops.reverse();
+                return Some((cur, hops));
+            }
+            expanded += 1;
+            if expanded > 400_000 {
+                return None;
+            }
+            for k in 0..12 {
+                let pivot = l.neighbour(c, k);
+                if !self.occupied.contains(&pivot) {
+                    continue;
+                }
+                let f = fcc::opposite(k);
+                for t in 0..12 {
+                    let routes = self.table[f][t];
+                    if routes.is_empty() {
+                        continue;
+                    }
+                    let to = l.neighbour(pivot, t);
+                    if self.occupied.contains(&to) || !self.in_bounds(to) {
+                        continue;
+                    }
+                    let ng = g + 1;
+                    if best.get(&to).is_some_and(|&(bg, _)| bg <= ng) {
+                        continue;
+                    }
+                    let Some(&route) = routes.iter().find(|&&route| {
+                        self.rules.allows(
+                            &Motion::Rotate {
+                                from: c,
+                                to,
+                                pivot,
+                                route,
+                            },
+                            &occ,
+                        )
+                    }) else {
+                        continue;
+                    };
+                    best.insert(to, (ng, Some((c, Hop { to, pivot, route }))));
+                    open.push(Reverse((ng as u64 * 1024 + h(to), ng, to)));
+                }
+            }
+        }
+        None
+    }
+
+    fn clear(&self, c: Cell, t: usize) -> bool {
+        if t >= self.positions.len() {
+            return true;
+        }
+        if self.swept[t].contains(&c) {
+            return false;
+        }
+        let p = &self.positions[t];
+        if p.is_empty() {
+            return true;
+        }
+        let l = FccLattice;
+        !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
+    }
+
+    /// Whether a module arriving at `c` at the end of `step` leaves every
+    /// later planned rotation allowed by the rules.
+    fn keeps_later_moves_legal(&self, c: Cell, step: usize) -> bool {
+        let par = c.z.rem_euclid(2) as usize;
+        for &(x, y, z) in &self.reach[par] {
+            let p = Cell::new(c.x + x, c.y + y, c.z + z);
+            let Some(moves) = self.moves_by_pivot.get(&p) else {
+                continue;
+            };
+            for (s, m) in moves.iter().filter(|(s, _)| *s > step) {
+                let occ =
+                    |q: Cell| q == c || self.module_at.get(&q).is_some_and(|&(_, at)| at < *s);
+                if !self.rules.allows(m, &occ) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    fn free_of_agents(&self, c: Cell, t: usize) -> bool {
+        t >= self.positions.len() || !self.positions[t].contains_key(&c)
+    }
+
+    /// Tries to follow `hops` from `src`, entering at step `t0`. Returns
+    /// the cell after each step from `t0` on, and the step of each hop.
+    fn follow(
+        &self,
+        t0: usize,
+        src: Cell,
+        hops: &[Hop],
+        ready: usize,
+    ) -> Option<(Vec<Cell>, Vec<usize>)> {
+        if !self.clear(src, t0 - 1) || !self.clear(src, t0) {
+            return None;
+        }
+        let mut cells = vec![src];
+        let mut steps = Vec::with_capacity(hops.len());
+        let mut t = t0;
+        let mut cur = src;
+        for (i, hop) in hops.iter().enumerate() {
+            let last = i + 1 == hops.len();
+            loop {
+                let step = t + 1;
+                let pivot_ready = self
+                    .module_at
+                    .get(&hop.pivot)
+                    .is_some_and(|&(_, at)| at < step);
+                let mut ok = pivot_ready && (!last || step > ready);
+                ok = ok
+                    && self.clear(hop.to, t)
+                    && self.clear(hop.to, step)
+                    && self.clear(cur, step);
+                if ok {
+                    let m = Motion::Rotate {
+                        from: cur,
+                        to: hop.to,
+                        pivot: hop.pivot,
+                        route: hop.route,
+                    };
+                    // Static modules in place and free agents (before or
+                    // after the step) are all obstacles.
+                    let occ = |q: Cell| {
+                        self.module_at.get(&q).is_some_and(|&(_, at)| at < step)
+                            || !self.free_of_agents(q, t)
+                            || !self.free_of_agents(q, step)
+                    };
+                    ok = self.rules.allows(&m, &occ);
+                }
+                if ok && last {
+                    // Once in place, the module must not stand in the way
+                    // of rotations planned for later steps.
+                    ok = self.last_use.get(&hop.to).is_none_or(|&u| u <= step)
+                        && self.keeps_later_moves_legal(hop.to, step);
+                }
+                if ok {
+                    cur = hop.to;
+                    t = step;
+                    cells.push(cur);
+                    steps.push(step);
+                    break;
+                }
+                if !self.clear(cur, step) {
+                    return None;
+                }
+                cells.push(cur);
+                t = step;
+            }
+        }
+        Some((cells, steps))
+    }
+
+    /// Plans module `id` from one of `srcs` (entry points with a start
+    /// penalty) to `dst`, arriving after step `ready`. Returns the entry
+    /// point used and the step at the end of which it is in place.
+    pub fn plan(
+        &mut self,
+        id: ModuleId,
+        srcs: &[(Cell, u32)],
+        dst: Cell,
+        ready: usize,
+    ) -> Result<(Cell, usize), InputError> {
+        let t_route = std::time::Instant::now();
+        let routed = self.route(srcs, dst);
+        self.timing.0 += t_route.elapsed().as_secs_f64();
+        let t_follow = std::time::Instant::now();
+        let (src, hops) = routed.ok_or_else(|| {
+            InputError::new(format!(
+                "no sequence of rotations leads from any entry point to cell {dst} over the structure \
+                 built so far"
+            ))
+            .for_module(id)
+        })?;
+        let mut t0 = (ready + 1).saturating_sub(hops.len()).max(1);
+        let (cells, steps) = loop {
+            if let Some(found) = self.follow(t0, src, &hops, ready) {
+                break found;
+            }
+            t0 += 1;
+        };
+        self.timing.1 += t_follow.elapsed().as_secs_f64();
+        let arrival = *steps.last().unwrap_or(&t0);
+        while self.positions.len() <= arrival {
+            self.positions.push(FxHashMap::default());
+            self.swept.push(FxHashSet::default());
+        }
+        while self.events.len() < arrival {
+            self.events.push(Vec::new());
+            self.placed_per_step.push(0);
+        }
+        for (k, &c) in cells.iter().enumerate() {
+            self.positions[t0 + k].insert(c, id);
+            let u = self.last_use.entry(c).or_insert(0);
+            *u = (*u).max(t0 + k);
+        }
+        self.events[t0 - 1].push(Event::Enter {
+            module: id,
+            cell: src,
+        });
+        let mut from = src;
+        for (hop, &step) in hops.iter().zip(&steps) {
+            let m = Motion::Rotate {
+                from,
+                to: hop.to,
+                pivot: hop.pivot,
+                route: hop.route,
+            };
+            self.moves_by_pivot
+                .entry(hop.pivot)
+                .or_default()
+                .push((step, m.clone()));
+            for b in self.rules.blocking_cells(&m) {
+                self.swept[step].insert(b);
+                let u = self.last_use.entry(b).or_insert(0);
+                *u = (*u).max(step);
+            }
+            let pivot = self.module_at[&hop.pivot].0;
+            self.events[step - 1].push(Event::Rotate {
+                module: id,
+                pivot,
+                from,
+                to: hop.to,
+                route: hop.route,
+            });
+            from = hop.to;
+        }
+        self.placed_per_step[arrival - 1] += 1;
+        self.occupied.insert(dst);
+        self.module_at.insert(dst, (id, arrival));
+        Ok((src, arrival))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_pivot_offers_48_hexagonal_and_72_octagonal_links() {
+        let t = rotation_table();
+        let hex = t
+            .iter()
+            .flatten()
+            .filter(|r| r.contains(&Route::Hexagonal))
+            .count();
+        let oct = t
+            .iter()
+            .flatten()
+            .filter(|r| r.contains(&Route::Octagonal))
+            .count();
+        assert_eq!((hex, oct), (48, 72));
+    }
+}

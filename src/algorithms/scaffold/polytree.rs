@@ -1,0 +1,244 @@
+//! Construction order (seed 000 §3.2.3–3.2.4, §3.3.2): the construction
+//! polytree of tiles and, inside each tile, the order of its components.
+//!
+//! The paper's IBR / TIR / RGP / PGP / CR / TCF messages enforce exactly
+//! these precedences in a distributed way; this generator is centralised,
+//! so it states them as a precedence graph on components:
+//!
+//! * a tile root comes after the tips of all the tile's ingoing branches
+//!   ("a tile can only begin its own construction once all of its ingoing
+//!   branches are complete"), which yields the diagonal growth from the
+//!   seed tile at minimal x, y;
+//! * the first module of each horizontal branch comes right after the
+//!   root, then the supports (§3.2.3 rules 1–2, §5.2.2: Opp branches as
+//!   early as possible). X1 lies between S_Z and S_RZ, Y1 between S_Z and
+//!   S_LZ: put in after both supports, it would have to enter a cell
+//!   between two opposite modules (bridging constraint);
+//! * the rest of a horizontal branch grows outwards after all supports and
+//!   first modules;
+//! * upward branches start after every horizontal branch of the tile is
+//!   complete (rule 3) and grow outwards.
+
+use super::scaffold::{Dir, Scaffold};
+use super::shape::Skew;
+use std::collections::BTreeMap;
+
+/// Precedences of a scaffold's components.
+#[derive(Clone, Debug)]
+pub struct Polytree {
+    /// Parent tiles of each tile (the tiles whose branches enter it).
+    pub parents: BTreeMap<Skew, Vec<Skew>>,
+    /// For each component (index into `Scaffold::components`), the
+    /// components that must be in place before it is.
+    pub preds: Vec<Vec<usize>>,
+}
+
+impl Polytree {
+    pub fn build(s: &Scaffold) -> Polytree {
+        let b = s.b;
+        let mut parents = BTreeMap::new();
+        let mut preds = vec![Vec::new(); s.components.len()];
+        for (&r, t) in &s.tiles {
+            let idx = |c: Skew| s.index.get(&c).copied();
+            let root = idx(r).expect("every tile has its root");
+            let mut ps = Vec::new();
+            let mut tips = Vec::new();
+            for &u in &t.ingoing_up {
+                if t.layer > 0 {
+                    ps.push(r.add(u.step().scale(-b)));
+                    tips.extend(idx(r.add(u.step().scale(-1))));
+                }
+            }
+            for &h in &t.ingoing_h {
+                ps.push(r.add(h.step().scale(-b)));
+                tips.extend(idx(r.add(h.step().scale(-1))));
+            }
+            parents.insert(r, ps);
+            preds[root] = tips;
+            let mut early = vec![root];
+            let mut horizontal_tips = Vec::new();
+            for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
+                let first = idx(r.add(d.step())).expect("branch module");
+                preds[first] = vec![root];
+                early.push(first);
+                horizontal_tips.push(idx(r.add(d.step().scale(len as i32))).expect("tip"));
+            }
+            // A first branch module lies between two supports (X1 between
+            // S_Z and S_RZ): it goes in before them (bridging constraint).
+            let firsts = early.clone();
+            // An upward branch with no support under it (its tile has no
+            // ingoing branch of the mirror direction, at a border) has no
+            // pivots for a climb from below once its neighbours are built:
+            // it grows right after the first modules, before anything
+            // else of the tile hems it in.
+            let unsupported: Vec<(Dir, u32)> = t
+                .branches
+                .iter()
+                .copied()
+                .filter(|(d, _)| {
+                    d.is_upward() && t.layer > 0 && !t.ingoing_up.contains(&d.mirror())
+                })
+                .collect();
+            let mut lone_prev: Option<usize> = None;
+            for &(d, len) in &unsupported {
+                for m in 1..=len as i32 {
+                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    preds[c] = if m == 1 {
+                        let mut p = firsts.clone();
+                        p.extend(lone_prev);
+                        p
+                    } else {
+                        vec![idx(r.add(d.step().scale(m - 1))).expect("previous")]
+                    };
+                }
+                let tip = idx(r.add(d.step().scale(len as i32))).expect("tip");
+                early.push(tip);
+                lone_prev = Some(tip);
+            }
+            for &u in &t.ingoing_up {
+                let si = idx(r.add(u.mirror().support_offset())).expect("support exists");
+                preds[si] = early.clone();
+                early.push(si);
+            }
+            for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
+                for m in 2..=len as i32 {
+                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    let mut p = early.clone();
+                    p.push(idx(r.add(d.step().scale(m - 1))).expect("previous"));
+                    preds[c] = p;
+                }
+            }
+            let ups: Vec<(Dir, u32)> = t
+                .branches
+                .iter()
+                .copied()
+                .filter(|b| b.0.is_upward() && !unsupported.contains(b))
+                .collect();
+            for &(d, len) in &ups {
+                for m in 1..=len as i32 {
+                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    preds[c] = if m == 1 {
+                        let mut p = early.clone();
+                        p.extend(&horizontal_tips);
+                        p
+                    } else {
+                        vec![idx(r.add(d.step().scale(m - 1))).expect("previous")]
+                    };
+                }
+            }
+        }
+        Polytree { parents, preds }
+    }
+
+    /// Height of the construction polytree: the longest chain of tiles.
+    pub fn height(&self) -> usize {
+        let mut depth: BTreeMap<Skew, usize> = BTreeMap::new();
+        // Parents sort before children (lower layer, or same layer and
+        // smaller x / y), so one pass in tile order suffices.
+        let mut tiles: Vec<&Skew> = self.parents.keys().collect();
+        tiles.sort_by_key(|r| (r.z, r.x + r.y, r.x));
+        for r in tiles {
+            let d = self.parents[r]
+                .iter()
+                .map(|p| depth[p] + 1)
+                .max()
+                .unwrap_or(0);
+            depth.insert(*r, d);
+        }
+        depth.values().copied().max().unwrap_or(0)
+    }
+
+    /// A topological order of the components (every component after its
+    /// predecessors), for planners that place them one by one.
+    pub fn topological(&self) -> Vec<usize> {
+        let n = self.preds.len();
+        let mut indeg: Vec<usize> = self.preds.iter().map(Vec::len).collect();
+        let mut succ = vec![Vec::new(); n];
+        for (i, ps) in self.preds.iter().enumerate() {
+            for &p in ps {
+                succ[p].push(i);
+            }
+        }
+        let mut ready: std::collections::VecDeque<usize> =
+            (0..n).filter(|&i| indeg[i] == 0).collect();
+        let mut out = Vec::with_capacity(n);
+        while let Some(i) = ready.pop_front() {
+            out.push(i);
+            for &j in &succ[i] {
+                indeg[j] -= 1;
+                if indeg[j] == 0 {
+                    ready.push_back(j);
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::shape::Pyramid;
+    use super::*;
+
+    fn pyramid(h: u32) -> Scaffold {
+        let top = (h as i32 - 1) * 6;
+        Scaffold::build(
+            &Pyramid { h, b: 6 },
+            6,
+            (Skew::new(0, 0, 0), Skew::new(top, top, top)),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn polytree_height_is_three_h_minus_one_for_pyramids() {
+        // Seed 000 Theorem 1.
+        for h in 2..=6 {
+            assert_eq!(
+                Polytree::build(&pyramid(h)).height(),
+                3 * (h as usize - 1),
+                "h = {h}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_tile_root_waits_for_all_its_ingoing_branches() {
+        let s = pyramid(3);
+        let p = Polytree::build(&s);
+        let r = Skew::new(6, 6, 0);
+        let root = s.index[&r];
+        let want: Vec<usize> = [Skew::new(5, 6, 0), Skew::new(6, 5, 0)]
+            .iter()
+            .map(|c| s.index[c])
+            .collect();
+        let mut got = p.preds[root].clone();
+        got.sort();
+        let mut want = want;
+        want.sort();
+        assert_eq!(got, want);
+        // A layer-1 root waits for its 4 ingoing upward branch tips (and none horizontal at the seed corner).
+        let up = s.index[&Skew::new(0, 0, 6)];
+        assert_eq!(p.preds[up].len(), 4);
+    }
+
+    #[test]
+    fn topological_order_covers_every_component_once() {
+        let s = pyramid(3);
+        let p = Polytree::build(&s);
+        let order = p.topological();
+        assert_eq!(order.len(), s.components.len());
+        let pos: Vec<usize> = {
+            let mut v = vec![0; order.len()];
+            for (k, &i) in order.iter().enumerate() {
+                v[i] = k;
+            }
+            v
+        };
+        for (i, ps) in p.preds.iter().enumerate() {
+            for &q in ps {
+                assert!(pos[q] < pos[i]);
+            }
+        }
+    }
+}
