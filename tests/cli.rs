@@ -275,3 +275,36 @@ fn generate_writes_a_schedule_that_certify_accepts() {
     let o = certify(&out);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+#[test]
+fn the_mechanics_check_runs_on_square_lattice_schedules_with_a_model() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = scratch("u-mech.json");
+    let o = bin()
+        .arg("run")
+        .arg(root.join("scenarios/u-shape-sas.toml"))
+        .arg("--model")
+        .arg(root.join("models/sliding-square.toml"))
+        .arg("--json")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let r: Value = serde_json::from_slice(&std::fs::read(out).unwrap()).unwrap();
+    assert!(
+        r["checks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c == "mechanics"),
+        "{}",
+        r["checks"]
+    );
+    let max = r["per_step"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s["metrics"]["max_utilisation"].as_f64())
+        .fold(0.0, f64::max);
+    assert!(max > 0.0 && max < 1.0, "max utilisation {max}");
+}
