@@ -68,6 +68,36 @@ fn default_activity() -> f64 {
 /// motion rules.
 pub type MoveFilter<'a> = dyn Fn(&Configuration, &Motion, &[Motion]) -> bool + 'a;
 
+/// A random rolling move for the walker at `from`: one of its
+/// down-neighbours (connectors 8..12) that `is_pivot` accepts, and that
+/// pivot's up-neighbours (connectors 4..8) that are free, not `from`, and
+/// neither claimed nor being vacated in this step — both drawn in random
+/// order. Shared by the walker workloads so that they draw alike.
+pub fn random_pivot_and_targets(
+    config: &Configuration,
+    from: Cell,
+    is_pivot: impl Fn(Cell) -> bool,
+    claimed: &FxHashSet<Cell>,
+    leaving: &FxHashSet<Cell>,
+    rng: &mut ChaCha8Rng,
+) -> Option<(Cell, Vec<Cell>)> {
+    let l = FccLattice;
+    let mut pivots: Vec<Cell> = (8..12)
+        .map(|k| l.neighbour(from, k))
+        .filter(|&c| is_pivot(c))
+        .collect();
+    pivots.shuffle(rng);
+    let &pivot = pivots.first()?;
+    let mut targets: Vec<Cell> = (4..8)
+        .map(|k| l.neighbour(pivot, k))
+        .filter(|&t| {
+            t != from && config.is_free(t) && !claimed.contains(&t) && !leaving.contains(&t)
+        })
+        .collect();
+    targets.shuffle(rng);
+    Some((pivot, targets))
+}
+
 /// The random-walk generator.
 pub struct RandomWalk;
 
@@ -150,22 +180,16 @@ pub fn walk(p: &WalkParams, filter: &MoveFilter<'_>) -> Schedule {
                 continue;
             }
             let from = config.cell_of(w).expect("walkers stay in the scene");
-            // Down-neighbours (connectors 8..12) that are platform modules.
-            let mut pivots: Vec<Cell> = (8..12)
-                .map(|k| l.neighbour(from, k))
-                .filter(|c| platform.contains(c))
-                .collect();
-            pivots.shuffle(&mut rng);
-            let Some(&pivot) = pivots.first() else {
+            let Some((pivot, targets)) = random_pivot_and_targets(
+                &config,
+                from,
+                |c| platform.contains(&c),
+                &claimed,
+                &leaving,
+                &mut rng,
+            ) else {
                 continue;
             };
-            let mut targets: Vec<Cell> = (4..8)
-                .map(|k| l.neighbour(pivot, k))
-                .filter(|&t| {
-                    t != from && config.is_free(t) && !claimed.contains(&t) && !leaving.contains(&t)
-                })
-                .collect();
-            targets.shuffle(&mut rng);
             for to in targets {
                 let n_f = (l.centre(from) - l.centre(pivot)).normalize();
                 let n_t = (l.centre(to) - l.centre(pivot)).normalize();

@@ -18,13 +18,7 @@ impl StepCheck for CollisionCheck {
     }
 
     fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome) {
-        let moves: Vec<_> = ctx
-            .plan
-            .moves
-            .iter()
-            .filter(|m| m.pivot_resolved)
-            .map(|m| (m.module, m.pivot, m.motion.clone()))
-            .collect();
+        let moves = ctx.plan.resolved_moves();
         if moves.is_empty() {
             return;
         }

@@ -168,13 +168,7 @@ impl StepCheck for LoadCheck {
     }
 
     fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome) {
-        let movers: Vec<MoverSpec> = ctx
-            .plan
-            .moves
-            .iter()
-            .filter(|m| m.pivot_resolved)
-            .map(|m| (m.module, m.pivot, m.motion.clone()))
-            .collect();
+        let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
         let (s, a) = self.analyse(ctx.world, &ctx.plan.moving, &movers);
         report(ctx.plan.step, &s, &a, out);
     }
@@ -208,12 +202,7 @@ pub fn replay(
             plan: &plan,
         };
         super::LatticeCheck.check(&ctx, &mut out);
-        let movers: Vec<MoverSpec> = plan
-            .moves
-            .iter()
-            .filter(|m| m.pivot_resolved)
-            .map(|m| (m.module, m.pivot, m.motion.clone()))
-            .collect();
+        let movers: Vec<MoverSpec> = plan.resolved_moves();
         let (s, a) = check.analyse(&world, &plan.moving, &movers);
         visit(k + 1, &s, &a, &out);
         let clashes = world.apply(&plan);

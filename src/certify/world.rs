@@ -58,6 +58,18 @@ pub struct StepPlan {
     pub violations: Vec<Violation>,
 }
 
+impl StepPlan {
+    /// The moves whose pivot could be resolved, as (mover, pivot, motion):
+    /// what the geometric and mechanical checks examine.
+    pub fn resolved_moves(&self) -> Vec<(ModuleId, Option<ModuleId>, Motion)> {
+        self.moves
+            .iter()
+            .filter(|m| m.pivot_resolved)
+            .map(|m| (m.module, m.pivot, m.motion.clone()))
+            .collect()
+    }
+}
+
 impl World {
     /// The initial scene of a schedule. Errors are input errors: duplicate
     /// ids, two modules in one cell, cells that are not on the lattice or

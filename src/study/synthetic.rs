@@ -84,21 +84,11 @@ pub fn islands_with_walkers(
                 continue;
             }
             let from = config.cell_of(m).expect("walker");
-            let mut pivots: Vec<Cell> = (8..12)
-                .map(|k| l.neighbour(from, k))
-                .filter(|c| in_top(*c))
-                .collect();
-            pivots.shuffle(&mut rng);
-            let Some(&pivot) = pivots.first() else {
+            let Some((pivot, targets)) = crate::algorithms::random_walk::random_pivot_and_targets(
+                &config, from, &in_top, &claimed, &leaving, &mut rng,
+            ) else {
                 continue;
             };
-            let mut targets: Vec<Cell> = (4..8)
-                .map(|k| l.neighbour(pivot, k))
-                .filter(|&t| {
-                    t != from && config.is_free(t) && !claimed.contains(&t) && !leaving.contains(&t)
-                })
-                .collect();
-            targets.shuffle(&mut rng);
             if let Some(&to) = targets.first() {
                 let n_f = (l.centre(from) - l.centre(pivot)).normalize();
                 let n_t = (l.centre(to) - l.centre(pivot)).normalize();
