@@ -126,12 +126,9 @@ impl Configuration {
             }
         }
         while let Some((m, c)) = stack.pop() {
-            for n in lattice.neighbours(c) {
-                if let Some(o) = self.at(n) {
-                    if !exclude.contains(&o) && !seen.contains(&o) && latched(m, o) {
-                        seen.insert(o);
-                        stack.push((o, n));
-                    }
+            for (o, n) in self.latched_neighbours(lattice, m, c, exclude, latched) {
+                if seen.insert(o) {
+                    stack.push((o, n));
                 }
             }
         }
@@ -146,6 +143,24 @@ impl Configuration {
 }
 
 impl Configuration {
+    /// The neighbours of module `m` (at `c`) that are present, not in
+    /// `exclude`, and latched to it, with their cells: the edges both
+    /// connectivity searches walk.
+    fn latched_neighbours<'a>(
+        &'a self,
+        lattice: &dyn Lattice,
+        m: ModuleId,
+        c: Cell,
+        exclude: &'a FxHashSet<ModuleId>,
+        latched: &'a dyn Fn(ModuleId, ModuleId) -> bool,
+    ) -> impl Iterator<Item = (ModuleId, Cell)> + 'a {
+        lattice
+            .neighbours(c)
+            .into_iter()
+            .filter_map(move |n| self.at(n).map(|o| (o, n)))
+            .filter(move |&(o, _)| !exclude.contains(&o) && latched(m, o))
+    }
+
     /// Like [`Configuration::unanchored`], but assuming every module is
     /// anchored before `exclude` is lifted (the configuration was connected),
     /// so only the static neighbours of the lifted modules can have lost
@@ -169,13 +184,7 @@ impl Configuration {
         let mut seeds: Vec<(ModuleId, Cell)> = Vec::new();
         for &x in exclude {
             let Some(cx) = self.cell_of(x) else { continue };
-            for n in lattice.neighbours(cx) {
-                if let Some(o) = self.at(n) {
-                    if !exclude.contains(&o) && latched(x, o) {
-                        seeds.push((o, n));
-                    }
-                }
-            }
+            seeds.extend(self.latched_neighbours(lattice, x, cx, exclude, latched));
         }
         seeds.sort_unstable();
         seeds.dedup();
@@ -192,12 +201,10 @@ impl Configuration {
                     found = true;
                     break;
                 }
-                for n in lattice.neighbours(c) {
-                    if let Some(o) = self.at(n) {
-                        if !exclude.contains(&o) && latched(m, o) && seen.insert(o) {
-                            visited.push(o);
-                            queue.push_back((o, n));
-                        }
+                for (o, n) in self.latched_neighbours(lattice, m, c, exclude, latched) {
+                    if seen.insert(o) {
+                        visited.push(o);
+                        queue.push_back((o, n));
                     }
                 }
             }
