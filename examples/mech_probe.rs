@@ -22,8 +22,8 @@ fn main() {
     let (mut its, mut solved, mut reused) = (0, 0, 0);
     replay(&s, &m, a[5] != 0, |_, _, r, _| {
         its += r.iterations;
-        solved += r.components_solved;
-        reused += r.components_reused;
+        solved += r.factorizations;
+        reused += 0;
     })
     .unwrap();
     println!(

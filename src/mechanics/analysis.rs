@@ -10,12 +10,13 @@
 
 use super::capacity::{ConnectorLoad, Mode, utilisation};
 use super::model::{Capacity, Model};
-use super::solver::{Block, BlockMatrix, Multigrid, SolveStats, Vec6, mg_pcg, pcg, transfer};
+use super::direct::Factor;
+use super::reuse::KeptFactor;
+use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
 use super::structure::{End, Link, Structure};
 use glam::DVec3;
 use nalgebra::Matrix3;
-use rustc_hash::{FxHashMap, FxHasher};
-use std::hash::{Hash, Hasher};
+use rustc_hash::FxHashMap;
 
 /// Result for one link (connector or ground contact).
 #[derive(Copy, Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -74,10 +75,10 @@ pub struct Analysis {
     pub max_utilisation: f64,
     pub critical: Option<Critical>,
     pub verdict: Option<Verdict>,
-    /// CG iterations summed over the components solved.
+    /// CG iterations (preconditioned by a kept factor, or refining a fresh
+    /// one) and sparse factorisations this analysis took.
     pub iterations: usize,
-    pub components_solved: usize,
-    pub components_reused: usize,
+    pub factorizations: usize,
 }
 
 impl Analysis {
@@ -93,9 +94,8 @@ pub struct Settings {
     pub tolerance: f64,
     /// Rounds of releasing ground contacts in tension.
     pub max_release_rounds: usize,
-    /// Components with at least this many modules use the multigrid
-    /// preconditioner, smaller ones block Jacobi.
-    pub multigrid_from: usize,
+    /// CG iterations allowed with a kept factor before it is refreshed.
+    pub reuse_iterations: usize,
 }
 
 impl Default for Settings {
@@ -103,10 +103,15 @@ impl Default for Settings {
         Settings {
             tolerance: 1e-10,
             max_release_rounds: 30,
-            multigrid_from: MULTIGRID_FROM,
+            reuse_iterations: REUSE_ITERATIONS,
         }
     }
 }
+
+/// CG iterations with a kept factor before it is refreshed: beyond this a
+/// fresh factorisation is cheaper than iterating on (measured on the
+/// sandcastle schedule, see `docs/mechanics.md`).
+pub const REUSE_ITERATIONS: usize = 25;
 
 /// Interface stiffnesses relative to the axial one, lengths in `d`:
 /// an elastic layer over the square of side `λ = L/d` — axial `EA/t`,
@@ -200,35 +205,41 @@ fn worst_lever(offsets: impl Iterator<Item = DVec3>, g: DVec3) -> DVec3 {
     best
 }
 
-/// A component's cached solution.
-#[derive(Clone, Debug)]
-struct Cached {
-    q: Vec<Vec6>,
-    /// Global link indices, valid only in the step that solved it.
-    released: Vec<usize>,
-    sliding: Vec<usize>,
-    /// Link results in the component's link order (empty until evaluated).
-    results: Vec<LinkResult>,
+/// A body's identity across steps: the module and the cell it rests in.
+type BodyKey = (u32, [i32; 3]);
+
+fn key(b: &super::structure::Body) -> BodyKey {
+    (b.module, b.cell.to_array())
+}
+
+/// The factor kept from an earlier step: the preconditioner of later ones.
+struct Reference {
+    factor: Factor,
+    /// Body → its block row in `factor`.
+    index: FxHashMap<BodyKey, u32>,
 }
 
 /// Analyses structures, optionally reusing work between consecutive calls
-/// (the steps of a schedule): components whose bodies, links and loads are
-/// unchanged are not solved again, and changed ones start CG from the
-/// previous displacements of their modules.
+/// (the steps of a schedule).
+///
+/// From scratch, every solve factors the step's stiffness matrix (sparse
+/// Cholesky). Incrementally, the factor of an earlier step is kept and
+/// preconditions CG on the current matrix, started from the previous
+/// displacements of the same bodies: consecutive steps differ by the few
+/// modules that start or stop moving, so the preconditioned matrix is the
+/// identity plus a low-rank change and CG converges in a few iterations.
+/// The factor is refreshed when that stops being true (CG needs more than
+/// [`Settings::reuse_iterations`]).
 pub struct Analyzer {
     pub model: Model,
     pub settings: Settings,
     pub incremental: bool,
     springs: Springs,
     ground_springs: Springs,
-    cache: FxHashMap<u64, Cached>,
-    warm: FxHashMap<u32, Vec6>,
+    warm: FxHashMap<BodyKey, Vec6>,
+    reference: Option<Reference>,
     blocks: FxHashMap<([u64; 3], bool, bool), LinkBlocks>,
 }
-
-/// Components at least this large are solved with the multigrid
-/// preconditioner; smaller ones with block Jacobi.
-pub const MULTIGRID_FROM: usize = 64;
 
 impl Analyzer {
     pub fn new(model: Model, incremental: bool) -> Analyzer {
@@ -240,16 +251,16 @@ impl Analyzer {
             incremental,
             springs,
             ground_springs,
-            cache: FxHashMap::default(),
             warm: FxHashMap::default(),
+            reference: None,
             blocks: FxHashMap::default(),
         }
     }
 
-    /// Forgets cached solutions.
+    /// Forgets what earlier steps left (factor and displacements).
     pub fn reset(&mut self) {
-        self.cache.clear();
         self.warm.clear();
+        self.reference = None;
     }
 
     /// The stiffness blocks of a link (cached by geometry: every link of a
@@ -301,139 +312,122 @@ impl Analyzer {
     pub fn analyse(&mut self, s: &Structure) -> Analysis {
         let nb = s.bodies.len();
         let loads = body_loads(s);
-        // Components of free bodies joined by body–body links.
-        let mut parent: Vec<usize> = (0..nb).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for l in &s.links {
-            if let End::Body(b) = l.b {
-                if !s.bodies[l.a].fixed && !s.bodies[b].fixed {
-                    let (ra, rb) = (find(&mut parent, l.a), find(&mut parent, b));
-                    if ra != rb {
-                        parent[ra.max(rb)] = ra.min(rb);
-                    }
-                }
-            }
-        }
-        let mut comp_of = vec![usize::MAX; nb];
-        let mut comps: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
-        for i in 0..nb {
-            if s.bodies[i].fixed {
-                continue;
-            }
-            let r = find(&mut parent, i);
-            if comp_of[r] == usize::MAX {
-                comp_of[r] = comps.len();
-                comps.push((Vec::new(), Vec::new()));
-            }
-            let c = comp_of[r];
-            comp_of[i] = c;
-            comps[c].0.push(i);
-        }
-        for (li, l) in s.links.iter().enumerate() {
-            let side = if s.bodies[l.a].fixed {
-                match l.b {
-                    End::Body(b) => b,
-                    End::Ground(_) => continue,
-                }
-            } else {
-                l.a
-            };
-            comps[comp_of[side]].1.push(li);
-        }
-
+        let comps = Components::of_structure(s);
         let mut out = Analysis {
             links: vec![LinkResult::default(); s.links.len()],
             ..Default::default()
         };
-        let mut any_unsupported = false;
-        let mut new_cache = FxHashMap::default();
-        let mut local = vec![u32::MAX; nb];
-        for (bodies, links) in &comps {
-            let sig = self.signature(s, bodies, links, &loads);
-            let cached = if self.incremental {
-                self.cache.get(&sig).cloned()
+        let mut released = vec![false; s.links.len()];
+        let mut sliding = vec![false; s.links.len()];
+        // Displacements of every free body (zeros where unsupported).
+        let mut q_all = vec![Vec6::zeros(); nb];
+        let mut anchored = vec![false; comps.count];
+        let mut warm_started = false;
+        for _round in 0..=self.settings.max_release_rounds {
+            // A component stands while some link ties it to the ground or
+            // to a fixed module.
+            anchored.iter_mut().for_each(|a| *a = false);
+            for (li, l) in s.links.iter().enumerate() {
+                if released[li] {
+                    continue;
+                }
+                let (ca, cb) = (comps.of(s, End::Body(l.a)), comps.of(s, l.b));
+                match (ca, cb) {
+                    (Some(c), None) | (None, Some(c)) => anchored[c] = true,
+                    _ => {}
+                }
+            }
+            let active: Vec<usize> = (0..nb)
+                .filter(|&b| comps.of(s, End::Body(b)).is_some_and(|c| anchored[c]))
+                .collect();
+            let mut local = vec![u32::MAX; nb];
+            for (k, &b) in active.iter().enumerate() {
+                local[b] = k as u32;
+            }
+            let k = self.assemble(s, &local, &released, &sliding, active.len());
+            let f: Vec<Vec6> = active.iter().map(|&b| loads[b]).collect();
+            let mut q: Vec<Vec6> = if warm_started || !self.incremental {
+                active.iter().map(|&b| q_all[b]).collect()
             } else {
-                None
+                active
+                    .iter()
+                    .map(|&b| {
+                        self.warm
+                            .get(&key(&s.bodies[b]))
+                            .copied()
+                            .unwrap_or_else(Vec6::zeros)
+                    })
+                    .collect()
             };
-            let sol = match cached {
-                Some(c) => {
-                    out.components_reused += 1;
-                    Some(c)
-                }
-                None => {
-                    out.components_solved += 1;
-                    for (k, &b) in bodies.iter().enumerate() {
-                        local[b] = k as u32;
-                    }
-                    let r =
-                        self.solve_component(s, bodies, links, &loads, &local, &mut out.iterations);
-                    for &b in bodies {
-                        local[b] = u32::MAX;
-                    }
-                    r
-                }
-            };
-            let Some(mut sol) = sol else {
-                any_unsupported = true;
-                out.unsupported.extend(bodies.iter().copied());
-                continue;
-            };
-            if sol.results.len() != links.len() {
-                // Freshly solved: evaluate every link once and keep the
-                // results (in the component's link order) for reuse.
-                if self.incremental {
-                    for (k, &b) in bodies.iter().enumerate() {
-                        self.warm.insert(s.bodies[b].module, sol.q[k]);
-                    }
-                }
-                for (k, &b) in bodies.iter().enumerate() {
-                    local[b] = k as u32;
-                }
-                let mut results = Vec::with_capacity(links.len());
-                for &li in links {
-                    let l = &s.links[li];
-                    results.push(if sol.released.contains(&li) {
-                        LinkResult {
-                            released: true,
-                            ..Default::default()
-                        }
-                    } else {
-                        let sliding = sol.sliding.contains(&li);
-                        let (load, force, moment) = self.link_forces(s, l, &sol.q, &local, sliding);
-                        let (u, m) = utilisation(&load, self.capacity(l));
-                        LinkResult {
-                            load,
-                            utilisation: u,
-                            mode: Some(m),
-                            released: false,
-                            sliding,
-                            force: force.to_array(),
-                            moment: moment.to_array(),
-                        }
-                    });
-                }
-                for &b in bodies {
-                    local[b] = u32::MAX;
-                }
-                sol.results = results;
-                sol.released.clear();
-                sol.sliding.clear();
+            warm_started = true;
+            self.solve(s, &active, &k, &f, &mut q, &mut out);
+            for (i, &b) in active.iter().enumerate() {
+                q_all[b] = q[i];
             }
-            for (k, &li) in links.iter().enumerate() {
-                out.links[li] = sol.results[k];
+            // Ground contacts pulled or tipped beyond their edge let go;
+            // failing that, those beyond their friction slide.
+            let mut lift = Vec::new();
+            let mut slide = Vec::new();
+            for (li, l) in s.links.iter().enumerate() {
+                if !l.is_ground() || released[li] || local[l.a] == u32::MAX {
+                    continue;
+                }
+                let load = self.link_forces(s, l, &q_all, sliding[li]).0;
+                let (u, mode) = utilisation(&load, &self.model.ground);
+                if u > 1.0 + 1e-9 {
+                    match mode {
+                        Mode::Bending => lift.push(li),
+                        Mode::Friction if !sliding[li] => slide.push(li),
+                        Mode::Friction => {}
+                    }
+                }
             }
-            if self.incremental {
-                new_cache.insert(sig, sol);
+            if !lift.is_empty() {
+                lift.into_iter().for_each(|li| released[li] = true);
+            } else if !slide.is_empty() {
+                slide.into_iter().for_each(|li| sliding[li] = true);
+            } else {
+                break;
             }
         }
         if self.incremental {
-            self.cache = new_cache;
+            self.warm.clear();
+            for (b, body) in s.bodies.iter().enumerate() {
+                if comps.of(s, End::Body(b)).is_some_and(|c| anchored[c]) {
+                    self.warm.insert(key(body), q_all[b]);
+                }
+            }
+        }
+        let mut any_unsupported = false;
+        for b in 0..nb {
+            if comps.of(s, End::Body(b)).is_some_and(|c| !anchored[c]) {
+                any_unsupported = true;
+                out.unsupported.push(b);
+            }
+        }
+        for (li, l) in s.links.iter().enumerate() {
+            let side = if s.bodies[l.a].fixed { l.b } else { End::Body(l.a) };
+            if !comps.of(s, side).is_some_and(|c| anchored[c]) {
+                continue;
+            }
+            out.links[li] = if released[li] {
+                LinkResult {
+                    released: true,
+                    ..Default::default()
+                }
+            } else {
+                let (load, force, moment) = self.link_forces(s, l, &q_all, sliding[li]);
+                let (u, m) = utilisation(&load, self.capacity(l));
+                LinkResult {
+                    load,
+                    utilisation: u,
+                    mode: Some(m),
+                    released: false,
+                    sliding: sliding[li],
+                    force: force.to_array(),
+                    moment: moment.to_array(),
+                }
+            };
         }
 
         // The connector holding each mover on its pivot.
@@ -512,44 +506,6 @@ impl Analyzer {
         out
     }
 
-    fn signature(&self, s: &Structure, bodies: &[usize], links: &[usize], loads: &[Vec6]) -> u64 {
-        let mut h = FxHasher::default();
-        for &b in bodies {
-            s.bodies[b].module.hash(&mut h);
-            s.bodies[b].cell.to_array().hash(&mut h);
-            for x in loads[b].iter() {
-                x.to_bits().hash(&mut h);
-            }
-        }
-        for &li in links {
-            let l = &s.links[li];
-            s.bodies[l.a].module.hash(&mut h);
-            match l.b {
-                End::Body(b) => (0u8, s.bodies[b].module).hash(&mut h),
-                End::Ground(c) => (1u8, c.to_array()).hash(&mut h),
-            }
-        }
-        h.finish()
-    }
-
-    fn side(&self, s: &Structure, e: End, local: &[u32]) -> Option<usize> {
-        match e {
-            End::Body(b) if !s.bodies[b].fixed && local[b] != u32::MAX => Some(local[b] as usize),
-            _ => None,
-        }
-    }
-
-    fn link_load(
-        &mut self,
-        s: &Structure,
-        l: &Link,
-        q: &[Vec6],
-        local: &[u32],
-        sliding: bool,
-    ) -> ConnectorLoad {
-        self.link_forces(s, l, q, local, sliding).0
-    }
-
     fn link_springs(&self, l: &Link, sliding: bool) -> Springs {
         let mut k = if l.is_ground() {
             self.ground_springs
@@ -570,16 +526,17 @@ impl Analyzer {
         s: &Structure,
         l: &Link,
         q: &[Vec6],
-        local: &[u32],
         sliding: bool,
     ) -> (ConnectorLoad, DVec3, DVec3) {
         let lb = self.link_blocks(s, l, sliding);
         let mut e = Vec6::zeros();
-        if let Some(a) = self.side(s, End::Body(l.a), local) {
-            e -= lb.ga * q[a];
+        if !s.bodies[l.a].fixed {
+            e -= lb.ga * q[l.a];
         }
-        if let Some(b) = self.side(s, l.b, local) {
-            e += lb.gb * q[b];
+        if let End::Body(b) = l.b {
+            if !s.bodies[b].fixed {
+                e += lb.gb * q[b];
+            }
         }
         let sf = lb.d * e;
         let f = DVec3::new(sf[0], sf[1], sf[2]);
@@ -598,113 +555,170 @@ impl Analyzer {
         (load, -f * w, -m * wd)
     }
 
-    /// Solves one component, releasing ground contacts that would pull
-    /// (or tip beyond the contact's edge) until the rest is consistent.
-    /// `None` when nothing supports the component.
-    fn solve_component(
+    /// The stiffness matrix over the bodies with a `local` index.
+    fn assemble(
         &mut self,
         s: &Structure,
-        bodies: &[usize],
-        links: &[usize],
-        loads: &[Vec6],
         local: &[u32],
-        iterations: &mut usize,
-    ) -> Option<Cached> {
-        let n = bodies.len();
-        let f: Vec<Vec6> = bodies.iter().map(|&b| loads[b]).collect();
-        let mut q: Vec<Vec6> = bodies
-            .iter()
-            .map(|&b| {
-                if self.incremental {
-                    self.warm
-                        .get(&s.bodies[b].module)
-                        .copied()
-                        .unwrap_or_else(Vec6::zeros)
+        released: &[bool],
+        sliding: &[bool],
+        n: usize,
+    ) -> BlockMatrix {
+        let mut k = BlockMatrix::new(n);
+        k.off.reserve(s.links.len());
+        let side = |e: End| match e {
+            End::Body(b) if local[b] != u32::MAX => Some(local[b] as usize),
+            _ => None,
+        };
+        for (li, l) in s.links.iter().enumerate() {
+            let (ia, ib) = (side(End::Body(l.a)), side(l.b));
+            if released[li] || (ia.is_none() && ib.is_none()) {
+                continue;
+            }
+            let lb = self.link_blocks(s, l, sliding[li]);
+            if let Some(a) = ia {
+                k.diag[a] += lb.kaa;
+            }
+            if let Some(b) = ib {
+                k.diag[b] += lb.kbb;
+            }
+            if let (Some(a), Some(b)) = (ia, ib) {
+                if a < b {
+                    k.off.push((a as u32, b as u32, lb.kab));
                 } else {
-                    Vec6::zeros()
+                    k.off.push((b as u32, a as u32, lb.kab.transpose()));
                 }
-            })
-            .collect();
-        let mut released: Vec<usize> = Vec::new();
-        let mut sliding: Vec<usize> = Vec::new();
-        for _round in 0..=self.settings.max_release_rounds {
-            let mut k = BlockMatrix::new(n);
-            k.off.reserve(links.len());
-            let mut anchored = false;
-            for &li in links {
-                if released.contains(&li) {
-                    continue;
-                }
-                let l = &s.links[li];
-                let lb = self.link_blocks(s, l, sliding.contains(&li));
-                let ia = self.side(s, End::Body(l.a), local);
-                let ib = self.side(s, l.b, local);
-                if ia.is_none() || ib.is_none() {
-                    anchored = true;
-                }
-                if let Some(a) = ia {
-                    k.diag[a] += lb.kaa;
-                }
-                if let Some(b) = ib {
-                    k.diag[b] += lb.kbb;
-                }
-                if let (Some(a), Some(b)) = (ia, ib) {
-                    if a < b {
-                        k.off.push((a as u32, b as u32, lb.kab));
-                    } else {
-                        k.off.push((b as u32, a as u32, lb.kab.transpose()));
-                    }
-                }
-            }
-            if !anchored {
-                return None;
-            }
-            let stats: SolveStats = if n >= self.settings.multigrid_from {
-                let pos: Vec<DVec3> = bodies.iter().map(|&b| s.bodies[b].centre).collect();
-                let mg = Multigrid::new(&k, &pos);
-                mg_pcg(&k, &mg, &f, &mut q, self.settings.tolerance, 2000)
-            } else {
-                pcg(&k, &f, &mut q, self.settings.tolerance, 50 * 6 * n + 1000)
-            };
-            *iterations += stats.iterations;
-            // Ground contacts pulled or tipped beyond their edge let go;
-            // failing that, those beyond their friction slide.
-            let mut lift = Vec::new();
-            let mut slide = Vec::new();
-            for &li in links {
-                let l = &s.links[li];
-                if !l.is_ground() || released.contains(&li) {
-                    continue;
-                }
-                let sl = sliding.contains(&li);
-                let load = self.link_load(s, l, &q, local, sl);
-                let (u, mode) = utilisation(&load, &self.model.ground);
-                if u > 1.0 + 1e-9 {
-                    match mode {
-                        Mode::Bending => lift.push(li),
-                        Mode::Friction if !sl => slide.push(li),
-                        Mode::Friction => {}
-                    }
-                }
-            }
-            if !lift.is_empty() {
-                released.extend(lift);
-            } else if !slide.is_empty() {
-                sliding.extend(slide);
-            } else {
-                return Some(Cached {
-                    q,
-                    released,
-                    sliding,
-                    results: Vec::new(),
-                });
             }
         }
-        Some(Cached {
-            q,
-            released,
-            sliding,
-            results: Vec::new(),
-        })
+        k
+    }
+
+    /// Solves `K q = f` over the `active` bodies: by a fresh factor, or
+    /// (incrementally) by CG preconditioned with the kept factor, falling
+    /// back to a fresh factor when that does not converge quickly.
+    fn solve(
+        &mut self,
+        s: &Structure,
+        active: &[usize],
+        k: &BlockMatrix,
+        f: &[Vec6],
+        q: &mut [Vec6],
+        out: &mut Analysis,
+    ) {
+        if k.is_empty() {
+            return;
+        }
+        let tol = self.settings.tolerance;
+        if self.incremental {
+            if let Some(r) = &self.reference {
+                let map: Vec<u32> = active
+                    .iter()
+                    .map(|&b| r.index.get(&key(&s.bodies[b])).copied().unwrap_or(u32::MAX))
+                    .collect();
+                let mut pre = KeptFactor::new(&r.factor, &map, k);
+                let mut apply = |res: &[Vec6], z: &mut [Vec6]| pre.apply(res, z);
+                let t0 = std::time::Instant::now();
+                let stats = pcg(k, &mut apply, f, q, tol, self.settings.reuse_iterations);
+                if std::env::var_os("RC_PROFILE").is_some() {
+                    eprintln!("pcg {} its {:.4}s rel {:.2e}", stats.iterations, t0.elapsed().as_secs_f64(), stats.relative_residual);
+                }
+                out.iterations += stats.iterations;
+                if stats.converged {
+                    return;
+                }
+            } else if pcg(k, &mut |r, z| z.copy_from_slice(r), f, q, tol, 0).converged {
+                // Already at the solution (nothing changed): no factor needed.
+                return;
+            }
+        }
+        let t0 = std::time::Instant::now();
+        let fac = Factor::new(k);
+        if std::env::var_os("RC_PROFILE").is_some() {
+            eprintln!("factor n={} off={} {:.4}s", k.len(), k.off.len(), t0.elapsed().as_secs_f64());
+        }
+        match fac {
+            Some(factor) => {
+                out.factorizations += 1;
+                q.copy_from_slice(f);
+                let t0 = std::time::Instant::now();
+                factor.solve_in_place(q);
+                if std::env::var_os("RC_PROFILE").is_some() {
+                    eprintln!("one solve {:.5}s", t0.elapsed().as_secs_f64());
+                }
+                // One step of refinement against round-off, if needed.
+                let mut apply = |res: &[Vec6], z: &mut [Vec6]| {
+                    z.copy_from_slice(res);
+                    factor.solve_in_place(z);
+                };
+                out.iterations += pcg(k, &mut apply, f, q, tol, 5).iterations;
+                if self.incremental {
+                    let index = active
+                        .iter()
+                        .enumerate()
+                        .map(|(i, &b)| (key(&s.bodies[b]), i as u32))
+                        .collect();
+                    self.reference = Some(Reference { factor, index });
+                }
+            }
+            None => {
+                // Not positive definite (a mechanism, e.g. a contact that
+                // slides): CG finds a least-energy answer in the range.
+                let n = k.len();
+                out.iterations += jacobi_pcg(k, f, q, tol, 50 * 6 * n + 1000).iterations;
+            }
+        }
+    }
+}
+
+/// Connected components of the free bodies (joined by body–body links).
+struct Components {
+    of: Vec<u32>,
+    count: usize,
+}
+
+impl Components {
+    fn of_structure(s: &Structure) -> Components {
+        let nb = s.bodies.len();
+        let mut parent: Vec<usize> = (0..nb).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        for l in &s.links {
+            if let End::Body(b) = l.b {
+                if !s.bodies[l.a].fixed && !s.bodies[b].fixed {
+                    let (ra, rb) = (find(&mut parent, l.a), find(&mut parent, b));
+                    if ra != rb {
+                        parent[ra.max(rb)] = ra.min(rb);
+                    }
+                }
+            }
+        }
+        let mut id = vec![u32::MAX; nb];
+        let mut of = vec![u32::MAX; nb];
+        let mut count = 0;
+        for i in 0..nb {
+            if s.bodies[i].fixed {
+                continue;
+            }
+            let r = find(&mut parent, i);
+            if id[r] == u32::MAX {
+                id[r] = count as u32;
+                count += 1;
+            }
+            of[i] = id[r];
+        }
+        Components { of, count }
+    }
+
+    /// The component of a link end: `None` for fixed bodies and the ground.
+    fn of(&self, s: &Structure, e: End) -> Option<usize> {
+        match e {
+            End::Body(b) if !s.bodies[b].fixed => Some(self.of[b] as usize),
+            _ => None,
+        }
     }
 }

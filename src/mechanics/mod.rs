@@ -8,6 +8,8 @@
 //!   movers hanging on their pivots, from any [`crate::lattice::Lattice`];
 //! * [`analysis`] — the static solve (elastic interface network, unilateral
 //!   ground by active set) with reuse between consecutive steps;
+//! * [`solver`], [`direct`] — preconditioned CG over 6 × 6 blocks and the
+//!   sparse Cholesky factor (faer) that preconditions it;
 //! * [`closed_form`] — the cantilever bounds the study is checked against.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
@@ -15,9 +17,11 @@
 pub mod analysis;
 pub mod capacity;
 pub mod closed_form;
+pub mod direct;
 pub mod dynamics;
 pub mod loadmap;
 pub mod model;
+pub mod reuse;
 pub mod solver;
 pub mod structure;
 

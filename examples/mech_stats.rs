@@ -1,0 +1,50 @@
+//! Probe: per-step statistics of a scenario's mechanical replay.
+use reconfcheck::certify::load_check::replay;
+use reconfcheck::mechanics::Model;
+use reconfcheck::scenario::Scenario;
+use rustc_hash::FxHashSet;
+use std::time::Instant;
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let sc = Scenario::load(std::path::Path::new(&args[0])).unwrap();
+    let t = Instant::now();
+    let s = reconfcheck::algorithms::generate(&sc).unwrap();
+    eprintln!("generated {} steps in {:.2}s", s.steps.len(), t.elapsed().as_secs_f64());
+    let incremental = args.get(1).map(|a| a == "1").unwrap_or(true);
+    let limit: usize = args.get(2).map(|a| a.parse().unwrap()).unwrap_or(usize::MAX);
+    let mut s = s;
+    s.steps.truncate(limit);
+    let m = Model::default_catom();
+    let mut prev: FxHashSet<(u32, [i32; 3])> = FxHashSet::default();
+    let t = Instant::now();
+    let mut last = Instant::now();
+    let mut tot_its = 0;
+    replay(&s, &m, incremental, |k, st, a, _| {
+        let cur: FxHashSet<(u32, [i32; 3])> = st
+            .bodies
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(|b| (b.module, b.cell.to_array()))
+            .collect();
+        let added = cur.difference(&prev).count();
+        let removed = prev.difference(&cur).count();
+        tot_its += a.iterations;
+        if k % 50 == 0 || k < 5 {
+            println!(
+                "step {k}: free {} links {} hanging {} +{added} -{removed} factorizations {} _{} its {} max_u {:.3} dt {:.3}s",
+                cur.len(),
+                st.links.len(),
+                st.hanging.len(),
+                a.factorizations,
+                0,
+                a.iterations,
+                a.max_utilisation,
+                last.elapsed().as_secs_f64()
+            );
+        }
+        last = Instant::now();
+        prev = cur;
+    })
+    .unwrap();
+    println!("total {:.2}s its {tot_its}", t.elapsed().as_secs_f64());
+}
