@@ -146,6 +146,10 @@ enum Command {
         samples: usize,
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Also repeat the study with this many base seeds (seed, seed + 1,
+        /// …) and print how much each box's median moves between studies.
+        #[arg(long)]
+        repeats: Option<usize>,
         /// Box plot (PNG, or SVG by extension).
         #[arg(short, long)]
         output: PathBuf,
@@ -245,6 +249,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             densities,
             samples,
             seed,
+            repeats,
             output,
         } => {
             use reconfcheck::algorithms::active_subtraction::study;
@@ -268,6 +273,10 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             print!("{}", study::table(&rows));
             study::plot(&cfg, &rows, &output).map_err(Failure::Output)?;
             eprintln!("wrote {}", output.display());
+            if let Some(n) = repeats.filter(|&n| n >= 2) {
+                let spread = study::spread(&cfg, n).map_err(bad)?;
+                print!("\n{}", study::spread_table(&spread, n));
+            }
             Ok(0)
         }
         Command::BStudy {

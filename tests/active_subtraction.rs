@@ -382,3 +382,32 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
     std::fs::remove_file(&png).ok();
     assert!(Path::new(&png).extension().is_some());
 }
+
+/// The shape our faithful §V-B generator gives (docs/active-subtraction.md,
+/// "Density study"): normalised SAS time and the best case rise with the
+/// density — not the paper's rise-and-fall — and PAS stays near the sink's
+/// rate of one arrival per two steps.
+#[test]
+fn density_study_sas_and_best_case_rise_with_density() {
+    let cfg = study::StudyConfig {
+        sizes: vec![10],
+        densities: vec![10, 40, 70],
+        // Fewer samples leave the medians within noise of each other
+        // (`density-study --repeats`: sd 0.3–0.5 at 80 samples).
+        samples: 80,
+        seed: 0,
+    };
+    let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
+    let sas: Vec<f64> = rows.iter().map(|r| r.sas.median).collect();
+    let best: Vec<f64> = rows.iter().map(|r| r.best.median).collect();
+    let pas: Vec<f64> = rows.iter().map(|r| r.pas.median).collect();
+    eprintln!("SAS {sas:?} best {best:?} PAS {pas:?}");
+    for k in 1..3 {
+        assert!(sas[k] > sas[k - 1] + 0.5, "SAS medians {sas:?}");
+        assert!(best[k] > best[k - 1] + 0.5, "best-case medians {best:?}");
+    }
+    assert!(
+        pas.iter().all(|&p| (2.0..2.6).contains(&p)),
+        "PAS medians {pas:?}"
+    );
+}

@@ -160,6 +160,82 @@ pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<Row> {
     out
 }
 
+/// How much a box's median moves between independent studies: the mean
+/// and standard deviation, over `repeats` studies with base seeds
+/// `cfg.seed, cfg.seed + 1, …`, of the SAS and best-case medians per
+/// `(size, density)`. Tells a trend from the noise of one 80-sample study
+/// (seed 003's Fig. 10 is one such study).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spread {
+    pub size: i32,
+    pub density: u32,
+    /// (mean, standard deviation) of the SAS median.
+    pub sas: (f64, f64),
+    /// (mean, standard deviation) of the best-case median.
+    pub best: (f64, f64),
+    /// Studies in which this box's SAS median is below the previous
+    /// density's (a "fall"); 0 for the first density.
+    pub sas_falls: usize,
+}
+
+/// Runs `repeats` studies (see [`Spread`]).
+pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> {
+    let mut medians: Vec<Vec<Row>> = Vec::new();
+    for r in 0..repeats as u64 {
+        let c = StudyConfig {
+            seed: cfg.seed.wrapping_add(r),
+            ..cfg.clone()
+        };
+        medians.push(summarise(&c, &run(&c)?));
+    }
+    let stats = |v: &[f64]| {
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        (m, var.sqrt())
+    };
+    let first = medians.first().cloned().unwrap_or_default();
+    Ok(first
+        .iter()
+        .enumerate()
+        .map(|(k, row)| {
+            let sas: Vec<f64> = medians.iter().map(|rs| rs[k].sas.median).collect();
+            let best: Vec<f64> = medians.iter().map(|rs| rs[k].best.median).collect();
+            let prev_same_size = k > 0 && first[k - 1].size == row.size;
+            let sas_falls = if prev_same_size {
+                medians
+                    .iter()
+                    .filter(|rs| rs[k].sas.median < rs[k - 1].sas.median)
+                    .count()
+            } else {
+                0
+            };
+            Spread {
+                size: row.size,
+                density: row.density,
+                sas: stats(&sas),
+                best: stats(&best),
+                sas_falls,
+            }
+        })
+        .collect())
+}
+
+/// The spread table, one row per `(size, density)`.
+pub fn spread_table(rows: &[Spread], repeats: usize) -> String {
+    let mut s = format!(
+        "medians over {repeats} studies (mean ± sd)\nsize    rho  SAS median       best-case median   SAS median below previous ρ\n"
+    );
+    for r in rows {
+        let size = r.size;
+        s += &format!(
+            "{size:>2}x{size:<2}  {:>2}%  {:>6.2} ± {:>4.2}    {:>6.2} ± {:>4.2}      {:>2} / {repeats}\n",
+            r.density, r.sas.0, r.sas.1, r.best.0, r.best.1, r.sas_falls
+        );
+    }
+    s
+}
+
 /// The summary table, one row per `(size, density)`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::from(
