@@ -334,6 +334,12 @@ fn the_large_cases_generate_and_certify() {
     certify_clean(&r, "random 50x50");
     // Seeded: generating again gives the same schedule.
     assert_eq!(scenario("random-50x50.toml"), r);
+    // SAS on the same configuration: one movement per step, 46,160 steps,
+    // each certified with the local connectivity search.
+    let sas = scenario("random-50x50-sas.toml");
+    assert_eq!(sas.steps.len(), 46_160);
+    assert_eq!(sas.move_count(), 46_160);
+    certify_clean(&sas, "random 50x50 SAS");
 }
 
 #[test]
