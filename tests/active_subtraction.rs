@@ -417,3 +417,51 @@ fn density_study_sas_and_best_case_rise_with_density() {
         "PAS medians {pas:?}"
     );
 }
+
+#[test]
+fn density_study_spread_summarises_the_medians_of_repeated_studies() {
+    let cfg = study::StudyConfig {
+        sizes: vec![10],
+        densities: vec![10, 50],
+        samples: 5,
+        seed: 7,
+    };
+    let spread = study::spread(&cfg, 3).unwrap();
+    assert_eq!(spread.len(), 2);
+    // The same medians, one study at a time.
+    let medians: Vec<Vec<f64>> = (7..10)
+        .map(|seed| {
+            let c = study::StudyConfig {
+                seed,
+                ..cfg.clone()
+            };
+            study::summarise(&c, &study::run(&c).unwrap())
+                .iter()
+                .map(|r| r.sas.median)
+                .collect()
+        })
+        .collect();
+    for (k, s) in spread.iter().enumerate() {
+        let v: Vec<f64> = medians.iter().map(|m| m[k]).collect();
+        let mean = v.iter().sum::<f64>() / 3.0;
+        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        assert!(
+            (s.sas.0 - mean).abs() < 1e-12 && (s.sas.1 - sd).abs() < 1e-12,
+            "{s:?}"
+        );
+        assert_eq!(s.repeats, 3);
+    }
+    assert_eq!(
+        spread[0].sas_falls, 0,
+        "the first density has no previous one"
+    );
+    let falls = medians.iter().filter(|m| m[1] < m[0]).count();
+    assert_eq!(spread[1].sas_falls, falls);
+    let table = study::spread_table(&spread, 3);
+    assert!(table.contains("10x10  50%"), "{table}");
+    let png = std::env::temp_dir().join(format!("reconfcheck-spread-{}.png", std::process::id()));
+    let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
+    study::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    std::fs::remove_file(&png).ok();
+}
