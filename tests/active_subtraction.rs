@@ -164,6 +164,31 @@ fn rotated_humanoid_takes_82_sas_and_36_pas_time_steps() {
 }
 
 #[test]
+fn humanoid_with_raised_arms_takes_the_papers_100_sas_and_40_pas_time_steps() {
+    // Second reconstruction of Fig. 7: the only symmetric candidate found
+    // that matches the paper's figures (docs/active-subtraction.md).
+    let h = shape_file("humanoid-arms-up-5x5.txt");
+    assert_eq!((h.included_count(), h.excluded_count()), (11, 14));
+    let sas = scenario("humanoid-arms-up-5x5-sas.toml");
+    let pas = scenario("humanoid-arms-up-5x5-pas.toml");
+    assert_eq!(sas.steps.len(), 100);
+    assert_eq!(pas.steps.len(), 40);
+    assert_eq!(pas.move_count(), 100, "PAS makes the same movements as SAS");
+    for (s, what) in [(&sas, "arms-up SAS"), (&pas, "arms-up PAS")] {
+        certify_clean(s, what);
+        check_replay(s, &h, what);
+    }
+    let up = root().join("models/shapes2d/humanoid-arms-up-5x5-upright.txt");
+    let e = Shape::load(&up).unwrap_err();
+    assert!(
+        e.message.contains("hollow")
+            && e.message.contains("1 excluded cell(s)")
+            && e.message.contains("(3, 1"),
+        "{e}"
+    );
+}
+
+#[test]
 fn the_upright_humanoid_is_hollow_and_rejected_with_its_file_named() {
     let path = root().join("models/shapes2d/humanoid-5x5-upright.txt");
     let e = Shape::load(&path).unwrap_err();
@@ -464,4 +489,61 @@ fn density_study_spread_summarises_the_medians_of_repeated_studies() {
     study::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();
     assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
     std::fs::remove_file(&png).ok();
+}
+
+/// The search behind `humanoid-arms-up-5x5.txt`: every left-right symmetric
+/// upright shape with a tight bounding box of 3–5 × 3–5 cells, on the
+/// ground, with exactly one enclosed cell, turned a quarter turn either way
+/// and set on the ground at every position in the 5 × 5 square.
+#[test]
+fn a_symmetric_search_finds_one_humanoid_with_the_papers_times() {
+    use reconfcheck::algorithms::active_subtraction::{pas, sas};
+    let mut seen = FxHashSet::default();
+    let mut hits = Vec::new();
+    for w in 3..=5i32 {
+        for h in 3..=5i32 {
+            let half = (w + 1) / 2;
+            for mask in 0u32..(1 << (half * h)) {
+                let inc = |x: i32, y: i32| {
+                    let xx = if x <= half { x } else { w + 1 - x };
+                    mask >> ((y - 1) * half + (xx - 1)) & 1 == 1
+                };
+                let empty_col = (1..=w).any(|x| (1..=h).all(|y| !inc(x, y)));
+                let empty_row = (1..=h).any(|y| (1..=w).all(|x| !inc(x, y)));
+                if empty_col || empty_row {
+                    continue;
+                }
+                let up = Shape::from_fn(w, h, |c| inc(c.x, c.y));
+                if !up.disconnected().is_empty() || up.enclosed().len() != 1 {
+                    continue;
+                }
+                for clockwise in [true, false] {
+                    // Turned: h wide, w tall; clockwise puts the head East.
+                    let turned = |x: i32, y: i32| {
+                        (1..=h).contains(&x)
+                            && (1..=w).contains(&y)
+                            && if clockwise {
+                                inc(w + 1 - y, x)
+                            } else {
+                                inc(y, h + 1 - x)
+                            }
+                    };
+                    for off in 0..=(5 - h) {
+                        let s = Shape::from_fn(5, 5, |c| turned(c.x - off, c.y));
+                        if s.validate().is_err() || !seen.insert(s.to_text()) {
+                            continue;
+                        }
+                        let run = sas::run(&s).unwrap();
+                        if run.time_steps() == 100
+                            && pas::plan(&s, &run).unwrap().time_steps() == 40
+                        {
+                            hits.push(s);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(seen.len(), 689);
+    assert_eq!(hits, vec![shape_file("humanoid-arms-up-5x5.txt")]);
 }
