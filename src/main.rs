@@ -146,6 +146,11 @@ enum Command {
         samples: usize,
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Also repeat the study with this many base seeds (seed, seed + 1,
+        /// …), print how much each box's median moves between studies and
+        /// draw the mean SAS median as a dashed line.
+        #[arg(long)]
+        repeats: Option<usize>,
         /// Box plot (PNG, or SVG by extension).
         #[arg(short, long)]
         output: PathBuf,
@@ -245,6 +250,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             densities,
             samples,
             seed,
+            repeats,
             output,
         } => {
             use reconfcheck::algorithms::active_subtraction::study;
@@ -266,7 +272,14 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             let samples = study::run(&cfg).map_err(bad)?;
             let rows = study::summarise(&cfg, &samples);
             print!("{}", study::table(&rows));
-            study::plot(&cfg, &rows, &output).map_err(Failure::Output)?;
+            let spread = match repeats.filter(|&n| n >= 2) {
+                Some(n) => study::spread(&cfg, n).map_err(bad)?,
+                None => Vec::new(),
+            };
+            if let Some(n) = repeats.filter(|&n| n >= 2) {
+                print!("\n{}", study::spread_table(&spread, n));
+            }
+            study::plot_with_spread(&cfg, &rows, &spread, &output).map_err(Failure::Output)?;
             eprintln!("wrote {}", output.display());
             Ok(0)
         }

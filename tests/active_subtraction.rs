@@ -164,6 +164,31 @@ fn rotated_humanoid_takes_82_sas_and_36_pas_time_steps() {
 }
 
 #[test]
+fn humanoid_with_raised_arms_takes_the_papers_100_sas_and_40_pas_time_steps() {
+    // Second reconstruction of Fig. 7: the only symmetric candidate found
+    // that matches the paper's figures (docs/active-subtraction.md).
+    let h = shape_file("humanoid-arms-up-5x5.txt");
+    assert_eq!((h.included_count(), h.excluded_count()), (11, 14));
+    let sas = scenario("humanoid-arms-up-5x5-sas.toml");
+    let pas = scenario("humanoid-arms-up-5x5-pas.toml");
+    assert_eq!(sas.steps.len(), 100);
+    assert_eq!(pas.steps.len(), 40);
+    assert_eq!(pas.move_count(), 100, "PAS makes the same movements as SAS");
+    for (s, what) in [(&sas, "arms-up SAS"), (&pas, "arms-up PAS")] {
+        certify_clean(s, what);
+        check_replay(s, &h, what);
+    }
+    let up = root().join("models/shapes2d/humanoid-arms-up-5x5-upright.txt");
+    let e = Shape::load(&up).unwrap_err();
+    assert!(
+        e.message.contains("hollow")
+            && e.message.contains("1 excluded cell(s)")
+            && e.message.contains("(3, 1"),
+        "{e}"
+    );
+}
+
+#[test]
 fn the_upright_humanoid_is_hollow_and_rejected_with_its_file_named() {
     let path = root().join("models/shapes2d/humanoid-5x5-upright.txt");
     let e = Shape::load(&path).unwrap_err();
@@ -334,6 +359,12 @@ fn the_large_cases_generate_and_certify() {
     certify_clean(&r, "random 50x50");
     // Seeded: generating again gives the same schedule.
     assert_eq!(scenario("random-50x50.toml"), r);
+    // SAS on the same configuration: one movement per step, 46,160 steps,
+    // each certified with the local connectivity search.
+    let sas = scenario("random-50x50-sas.toml");
+    assert_eq!(sas.steps.len(), 46_160);
+    assert_eq!(sas.move_count(), 46_160);
+    certify_clean(&sas, "random 50x50 SAS");
 }
 
 #[test]
@@ -381,4 +412,138 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
     assert_eq!(&bytes[1..4], b"PNG");
     std::fs::remove_file(&png).ok();
     assert!(Path::new(&png).extension().is_some());
+}
+
+/// The shape our faithful §V-B generator gives (docs/active-subtraction.md,
+/// "Density study"): normalised SAS time and the best case rise with the
+/// density — not the paper's rise-and-fall — and PAS stays near the sink's
+/// rate of one arrival per two steps.
+#[test]
+fn density_study_sas_and_best_case_rise_with_density() {
+    let cfg = study::StudyConfig {
+        sizes: vec![10],
+        densities: vec![10, 40, 70],
+        // Fewer samples leave the medians within noise of each other
+        // (`density-study --repeats`: sd 0.3–0.5 at 80 samples).
+        samples: 80,
+        seed: 0,
+    };
+    let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
+    let sas: Vec<f64> = rows.iter().map(|r| r.sas.median).collect();
+    let best: Vec<f64> = rows.iter().map(|r| r.best.median).collect();
+    let pas: Vec<f64> = rows.iter().map(|r| r.pas.median).collect();
+    eprintln!("SAS {sas:?} best {best:?} PAS {pas:?}");
+    for k in 1..3 {
+        assert!(sas[k] > sas[k - 1] + 0.5, "SAS medians {sas:?}");
+        assert!(best[k] > best[k - 1] + 0.5, "best-case medians {best:?}");
+    }
+    assert!(
+        pas.iter().all(|&p| (2.0..2.6).contains(&p)),
+        "PAS medians {pas:?}"
+    );
+}
+
+#[test]
+fn density_study_spread_summarises_the_medians_of_repeated_studies() {
+    let cfg = study::StudyConfig {
+        sizes: vec![10],
+        densities: vec![10, 50],
+        samples: 5,
+        seed: 7,
+    };
+    let spread = study::spread(&cfg, 3).unwrap();
+    assert_eq!(spread.len(), 2);
+    // The same medians, one study at a time.
+    let medians: Vec<Vec<f64>> = (7..10)
+        .map(|seed| {
+            let c = study::StudyConfig {
+                seed,
+                ..cfg.clone()
+            };
+            study::summarise(&c, &study::run(&c).unwrap())
+                .iter()
+                .map(|r| r.sas.median)
+                .collect()
+        })
+        .collect();
+    for (k, s) in spread.iter().enumerate() {
+        let v: Vec<f64> = medians.iter().map(|m| m[k]).collect();
+        let mean = v.iter().sum::<f64>() / 3.0;
+        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        assert!(
+            (s.sas.0 - mean).abs() < 1e-12 && (s.sas.1 - sd).abs() < 1e-12,
+            "{s:?}"
+        );
+        assert_eq!(s.repeats, 3);
+    }
+    assert_eq!(
+        spread[0].sas_falls, 0,
+        "the first density has no previous one"
+    );
+    let falls = medians.iter().filter(|m| m[1] < m[0]).count();
+    assert_eq!(spread[1].sas_falls, falls);
+    let table = study::spread_table(&spread, 3);
+    assert!(table.contains("10x10  50%"), "{table}");
+    let png = std::env::temp_dir().join(format!("reconfcheck-spread-{}.png", std::process::id()));
+    let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
+    study::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    std::fs::remove_file(&png).ok();
+}
+
+/// The search behind `humanoid-arms-up-5x5.txt`: every left-right symmetric
+/// upright shape with a tight bounding box of 3–5 × 3–5 cells, on the
+/// ground, with exactly one enclosed cell, turned a quarter turn either way
+/// and set on the ground at every position in the 5 × 5 square.
+#[test]
+fn a_symmetric_search_finds_one_humanoid_with_the_papers_times() {
+    use reconfcheck::algorithms::active_subtraction::{pas, sas};
+    let mut seen = FxHashSet::default();
+    let mut hits = Vec::new();
+    for w in 3..=5i32 {
+        for h in 3..=5i32 {
+            let half = (w + 1) / 2;
+            for mask in 0u32..(1 << (half * h)) {
+                let inc = |x: i32, y: i32| {
+                    let xx = if x <= half { x } else { w + 1 - x };
+                    mask >> ((y - 1) * half + (xx - 1)) & 1 == 1
+                };
+                let empty_col = (1..=w).any(|x| (1..=h).all(|y| !inc(x, y)));
+                let empty_row = (1..=h).any(|y| (1..=w).all(|x| !inc(x, y)));
+                if empty_col || empty_row {
+                    continue;
+                }
+                let up = Shape::from_fn(w, h, |c| inc(c.x, c.y));
+                if !up.disconnected().is_empty() || up.enclosed().len() != 1 {
+                    continue;
+                }
+                for clockwise in [true, false] {
+                    // Turned: h wide, w tall; clockwise puts the head East.
+                    let turned = |x: i32, y: i32| {
+                        (1..=h).contains(&x)
+                            && (1..=w).contains(&y)
+                            && if clockwise {
+                                inc(w + 1 - y, x)
+                            } else {
+                                inc(y, h + 1 - x)
+                            }
+                    };
+                    for off in 0..=(5 - h) {
+                        let s = Shape::from_fn(5, 5, |c| turned(c.x - off, c.y));
+                        if s.validate().is_err() || !seen.insert(s.to_text()) {
+                            continue;
+                        }
+                        let run = sas::run(&s).unwrap();
+                        if run.time_steps() == 100
+                            && pas::plan(&s, &run).unwrap().time_steps() == 40
+                        {
+                            hits.push(s);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(seen.len(), 689);
+    assert_eq!(hits, vec![shape_file("humanoid-arms-up-5x5.txt")]);
 }

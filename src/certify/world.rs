@@ -141,12 +141,22 @@ impl World {
     }
 
     /// The modules not connected to the ground or a fixed module, with
-    /// `exclude` taken out of the structure.
+    /// `exclude` taken out of the structure. When the scene is known to be
+    /// anchored (see [`World::set_anchored`]) only the neighbours of the
+    /// lifted modules can have lost their anchor, and the search stays local
+    /// to them ([`Configuration::unanchored_near`]): a step then costs in
+    /// proportion to the movers' surroundings, not to the whole structure.
+    /// With any latch released the full search runs (a mover could have come
+    /// to rest beside a module it is unlatched from).
     pub fn unanchored(&self, exclude: &FxHashSet<ModuleId>) -> Vec<ModuleId> {
-        self.config
-            .unanchored(self.lattice, self.ground, &self.fixed, exclude, &|a, b| {
-                self.latched(a, b)
-            })
+        let latched = |a, b| self.latched(a, b);
+        if self.anchored && self.detached.is_empty() {
+            self.config
+                .unanchored_near(self.lattice, self.ground, &self.fixed, exclude, &latched)
+        } else {
+            self.config
+                .unanchored(self.lattice, self.ground, &self.fixed, exclude, &latched)
+        }
     }
 
     /// Records whether every module is known to be anchored now. True only

@@ -3,6 +3,8 @@
 
 use super::{Cell, Lattice};
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// Module identifier, as written in schedule files.
 pub type ModuleId = u32;
@@ -167,7 +169,12 @@ impl Configuration {
     /// their anchor: a component of the remainder that holds no anchor was
     /// joined to one only through a lifted module, so it contains one of
     /// their neighbours. Searches stop at the first anchor found, which keeps
-    /// the cost local to the movers in a well-connected structure.
+    /// the cost local to the movers in a well-connected structure. They are
+    /// best-first, lowest layer first: the ground is below, so in a solid
+    /// structure a search walks down to it in about as many steps as the
+    /// mover is high, where a breadth-first search would visit the whole
+    /// ball of that radius. (The order changes only the cost: a failed
+    /// search still exhausts its component.)
     pub fn unanchored_near(
         &self,
         lattice: &dyn Lattice,
@@ -194,9 +201,10 @@ impl Configuration {
             }
             let mut visited: Vec<ModuleId> = vec![seed];
             let mut seen: FxHashSet<ModuleId> = [seed].into_iter().collect();
-            let mut queue = std::collections::VecDeque::from([(seed, seed_cell)]);
+            let key = |m: ModuleId, c: Cell| Reverse((lattice.layer(c), m, c));
+            let mut queue = BinaryHeap::from([key(seed, seed_cell)]);
             let mut found = false;
-            while let Some((m, c)) = queue.pop_front() {
+            while let Some(Reverse((_, m, c))) = queue.pop() {
                 if is_anchor(m, c) || anchored.contains(&m) {
                     found = true;
                     break;
@@ -204,7 +212,7 @@ impl Configuration {
                 for (o, n) in self.latched_neighbours(lattice, m, c, exclude, latched) {
                     if seen.insert(o) {
                         visited.push(o);
-                        queue.push_back((o, n));
+                        queue.push(key(o, n));
                     }
                 }
             }

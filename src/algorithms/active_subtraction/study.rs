@@ -160,6 +160,89 @@ pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<Row> {
     out
 }
 
+/// How much a box's median moves between independent studies: the mean
+/// and standard deviation, over `repeats` studies with base seeds
+/// `cfg.seed, cfg.seed + 1, …`, of the SAS and best-case medians per
+/// `(size, density)`. Tells a trend from the noise of one 80-sample study
+/// (seed 003's Fig. 10 is one such study).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spread {
+    pub size: i32,
+    pub density: u32,
+    /// Studies repeated.
+    pub repeats: usize,
+    /// (mean, standard deviation) of the SAS median.
+    pub sas: (f64, f64),
+    /// (mean, standard deviation) of the best-case median.
+    pub best: (f64, f64),
+    /// Studies in which this box's SAS median is below the previous
+    /// density's (a "fall"); 0 for the first density.
+    pub sas_falls: usize,
+}
+
+fn spread_len(spread: &[Spread]) -> usize {
+    spread.first().map_or(0, |r| r.repeats)
+}
+
+/// Runs `repeats` studies (see [`Spread`]).
+pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> {
+    let mut medians: Vec<Vec<Row>> = Vec::new();
+    for r in 0..repeats as u64 {
+        let c = StudyConfig {
+            seed: cfg.seed.wrapping_add(r),
+            ..cfg.clone()
+        };
+        medians.push(summarise(&c, &run(&c)?));
+    }
+    let stats = |v: &[f64]| {
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        (m, var.sqrt())
+    };
+    let first = medians.first().cloned().unwrap_or_default();
+    Ok(first
+        .iter()
+        .enumerate()
+        .map(|(k, row)| {
+            let sas: Vec<f64> = medians.iter().map(|rs| rs[k].sas.median).collect();
+            let best: Vec<f64> = medians.iter().map(|rs| rs[k].best.median).collect();
+            let prev_same_size = k > 0 && first[k - 1].size == row.size;
+            let sas_falls = if prev_same_size {
+                medians
+                    .iter()
+                    .filter(|rs| rs[k].sas.median < rs[k - 1].sas.median)
+                    .count()
+            } else {
+                0
+            };
+            Spread {
+                size: row.size,
+                density: row.density,
+                repeats,
+                sas: stats(&sas),
+                best: stats(&best),
+                sas_falls,
+            }
+        })
+        .collect())
+}
+
+/// The spread table, one row per `(size, density)`.
+pub fn spread_table(rows: &[Spread], repeats: usize) -> String {
+    let mut s = format!(
+        "medians over {repeats} studies (mean ± sd)\nsize    rho  SAS median       best-case median   SAS median below previous ρ\n"
+    );
+    for r in rows {
+        let size = r.size;
+        s += &format!(
+            "{size:>2}x{size:<2}  {:>2}%  {:>6.2} ± {:>4.2}    {:>6.2} ± {:>4.2}      {:>2} / {repeats}\n",
+            r.density, r.sas.0, r.sas.1, r.best.0, r.best.1, r.sas_falls
+        );
+    }
+    s
+}
+
 /// The summary table, one row per `(size, density)`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::from(
@@ -178,6 +261,18 @@ pub fn table(rows: &[Row]) -> String {
 /// Box plot of the normalised times (log scale), like the paper's Fig. 10:
 /// per density, SAS and PAS for each size (lighter boxes: smaller size).
 pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> {
+    plot_with_spread(cfg, rows, &[], path)
+}
+
+/// [`plot`], plus — when `spread` is not empty — the mean over repeated
+/// studies of each box's SAS median (a dashed line per size), which shows
+/// the expected trend behind the noise of one study's medians.
+pub fn plot_with_spread(
+    cfg: &StudyConfig,
+    rows: &[Row],
+    spread: &[Spread],
+    path: &Path,
+) -> Result<(), String> {
     let mut svg = String::new();
     {
         let root = SvgCanvas::with_string(&mut svg, (960, 540)).into_drawing_area();
@@ -204,7 +299,7 @@ pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> 
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(-0.5..n - 0.5, (lo / 1.5).log10()..(hi * 4.0).log10())
+            .build_cartesian_2d(-0.5..n - 0.5, (lo / 1.5).log10()..(hi * 8.0).log10())
             .map_err(|e| e.to_string())?;
         let densities = cfg.densities.clone();
         chart
@@ -227,7 +322,7 @@ pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> 
             .map_err(|e| e.to_string())?;
         // Log scale by hand: the axis is log10 of the value, with ticks at
         // 1-2-5 steps (plotters' log axis labels decades only).
-        let (y0, y1) = ((lo / 1.5).log10(), (hi * 4.0).log10());
+        let (y0, y1) = ((lo / 1.5).log10(), (hi * 8.0).log10());
         let ticks: Vec<f64> = (-3..4)
             .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
             .filter(|t| (y0..=y1).contains(&t.log10()))
@@ -350,6 +445,30 @@ pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> 
                         .map(|p| Circle::new(p, 3, style.filled())),
                 )
                 .map_err(|e| e.to_string())?;
+        }
+        for (si, &size) in cfg.sizes.iter().enumerate() {
+            let points: Vec<(f64, f64)> = spread
+                .iter()
+                .filter(|r| r.size == size)
+                .filter_map(|r| {
+                    let k = cfg.densities.iter().position(|&d| d == r.density)? as f64;
+                    Some((k, r.sas.0.log10()))
+                })
+                .collect();
+            if points.is_empty() {
+                continue;
+            }
+            let light = si + 1 < cfg.sizes.len();
+            let colour = RGBColor(31, 119, 180).mix(if light { 0.5 } else { 1.0 });
+            let style = colour.stroke_width(2);
+            chart
+                .draw_series(DashedLineSeries::new(points, 6, 4, style))
+                .map_err(|e| e.to_string())?
+                .label(format!(
+                    "SAS {size}×{size}: mean median of {} studies",
+                    spread_len(spread)
+                ))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
         }
         chart
             .configure_series_labels()
