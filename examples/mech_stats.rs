@@ -9,9 +9,16 @@ fn main() {
     let sc = Scenario::load(std::path::Path::new(&args[0])).unwrap();
     let t = Instant::now();
     let s = reconfcheck::algorithms::generate(&sc).unwrap();
-    eprintln!("generated {} steps in {:.2}s", s.steps.len(), t.elapsed().as_secs_f64());
+    eprintln!(
+        "generated {} steps in {:.2}s",
+        s.steps.len(),
+        t.elapsed().as_secs_f64()
+    );
     let incremental = args.get(1).map(|a| a == "1").unwrap_or(true);
-    let limit: usize = args.get(2).map(|a| a.parse().unwrap()).unwrap_or(usize::MAX);
+    let limit: usize = args
+        .get(2)
+        .map(|a| a.parse().unwrap())
+        .unwrap_or(usize::MAX);
     let mut s = s;
     s.steps.truncate(limit);
     let m = Model::default_catom();

@@ -137,7 +137,13 @@ pub fn pcg(
 }
 
 /// [`pcg`] with the block-Jacobi preconditioner.
-pub fn jacobi_pcg(k: &BlockMatrix, f: &[Vec6], x: &mut [Vec6], tol: f64, max_iter: usize) -> SolveStats {
+pub fn jacobi_pcg(
+    k: &BlockMatrix,
+    f: &[Vec6],
+    x: &mut [Vec6],
+    tol: f64,
+    max_iter: usize,
+) -> SolveStats {
     let pre = block_jacobi(k);
     let mut apply = |r: &[Vec6], z: &mut [Vec6]| {
         for ((zi, ri), p) in z.iter_mut().zip(r).zip(&pre) {
@@ -190,4 +196,3 @@ pub fn transfer(r: glam::DVec3) -> Block {
     g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
     g
 }
-
