@@ -366,6 +366,7 @@ impl Study {
             root.fill(&WHITE).map_err(|e| e.to_string())?;
             let (left, right) = root.split_horizontally(600);
             let bmax = self.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 0.5;
+            let bmin = self.rows.iter().map(|r| r.b).min().unwrap_or(1) as f64 - 0.5;
             let umax = self
                 .rows
                 .iter()
@@ -385,7 +386,7 @@ impl Study {
                 .margin(12)
                 .x_label_area_size(40)
                 .y_label_area_size(55)
-                .build_cartesian_2d(0.5..bmax, 0.0..umax)
+                .build_cartesian_2d(bmin..bmax, 0.0..umax)
                 .map_err(|e| e.to_string())?;
             c.configure_mesh()
                 .x_desc("branch length b (modules)")
@@ -393,7 +394,7 @@ impl Study {
                 .draw()
                 .map_err(|e| e.to_string())?;
             c.draw_series(LineSeries::new(
-                [(0.5, 1.0), (bmax, 1.0)],
+                [(bmin, 1.0), (bmax, 1.0)],
                 BLACK.stroke_width(1),
             ))
             .map_err(|e| e.to_string())?;
@@ -443,7 +444,7 @@ impl Study {
                 .margin(12)
                 .x_label_area_size(40)
                 .y_label_area_size(55)
-                .build_cartesian_2d(0.5..bmax, (0.1..pmax).log_scale())
+                .build_cartesian_2d(bmin..bmax, (0.1..pmax).log_scale())
                 .map_err(|e| e.to_string())?;
             c.configure_mesh()
                 .x_desc("branch length b (modules)")
@@ -455,13 +456,13 @@ impl Study {
                 (133.0, "ideal parallel plate 133 kPa"),
             ] {
                 c.draw_series(LineSeries::new(
-                    [(0.5, kpa), (bmax, kpa)],
+                    [(bmin, kpa), (bmax, kpa)],
                     BLACK.mix(0.5).stroke_width(1),
                 ))
                 .map_err(|e| e.to_string())?;
                 c.draw_series(std::iter::once(Text::new(
                     label,
-                    (0.7, kpa * 1.08),
+                    (bmin + 0.2, kpa * 1.08),
                     ("sans-serif", 12),
                 )))
                 .map_err(|e| e.to_string())?;
