@@ -39,7 +39,7 @@ fn compare(c: &mut Criterion, name: &str, s: &Schedule) {
     let mut g = c.benchmark_group(name);
     g.sample_size(10)
         .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(20));
+        .measurement_time(Duration::from_secs(30));
     g.bench_function("incremental", |bench| {
         bench.iter(|| run(black_box(s), &m, true))
     });

@@ -92,8 +92,10 @@ pub type FamilyFn = Box<dyn Fn(usize) -> Result<Schedule, InputError>>;
 /// * `pyramid` — seed 000's scaffold of an `size`-pyramid (default 2),
 ///   assembled from the sandbox with branch length `b`;
 /// * `cube` — seed 000's scaffold of the cube of `size` tiles a side
-///   (default 2) with full border branches (`e = b − 1`: side
-///   `size · b − 1` modules, the largest cube of `size` tiles).
+///   (default 2), side `(size − 1)·b + e` modules with `e = b − 1` (border
+///   branches of `b − 2` modules). Not the generator's default `e = b`:
+///   with it the planner finds no route for one module of the 2-tile cube
+///   at `b = 4`; `e = b − 1` plans for every `b` from 4 to 10.
 ///
 /// `size` is ignored by `branch`. Scaffold families need `b ≥ 4`
 /// (seed 000 §3.2.2); the generator says so for smaller `b`.
@@ -117,7 +119,10 @@ pub fn family(name: &str, spacing_mm: f64, size: Option<u32>) -> Result<FamilyFn
         })),
         "pyramid" => Ok(Box::new(move |b| scaffold(ShapeSpec::Pyramid { h }, b))),
         "cube" => Ok(Box::new(move |b| {
-            let e = (b as u32).saturating_sub(1).max(1);
+            let e = u32::try_from(b)
+                .unwrap_or(u32::MAX)
+                .saturating_sub(1)
+                .max(1);
             scaffold(ShapeSpec::Cube { h, e }, b)
         })),
         other => Err(InputError::new(format!(
@@ -604,10 +609,15 @@ mod tests {
             assert!(!r.no_equilibrium, "b = {}", r.b);
         }
         assert!(st.rows[1].max_utilisation > st.rows[0].max_utilisation);
-        // A 2-tile cube holds more modules than the 2-pyramid of equal b.
-        let pyramid = family("pyramid", 3.6, None).unwrap()(4).unwrap();
-        let cube = family("cube", 3.6, None).unwrap()(4).unwrap();
-        assert!(cube.steps.len() > pyramid.steps.len());
+        // A cube of 2 tiles a side holds more modules than the 2-pyramid of
+        // equal b, and more as b grows.
+        let modules = |f: &str, b: usize| {
+            family(f, 3.6, None).unwrap()(b).unwrap().meta["scaffold_modules"]
+                .as_u64()
+                .unwrap()
+        };
+        assert!(modules("cube", 4) > modules("pyramid", 4));
+        assert!(modules("cube", 5) > modules("cube", 4));
     }
 
     #[test]
