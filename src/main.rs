@@ -100,12 +100,16 @@ enum Command {
         /// Physical model (TOML).
         #[arg(long, value_name = "FILE", default_value = "models/catom-3.6mm.toml")]
         model: PathBuf,
-        /// Smallest branch length.
-        #[arg(long, default_value_t = 1)]
-        b_min: usize,
-        /// Largest branch length.
-        #[arg(long, default_value_t = 10)]
-        b_max: usize,
+        /// Shape size of scaffold families (pyramid: h; cube: tiles a side;
+        /// default 2).
+        #[arg(long)]
+        size: Option<u32>,
+        /// Smallest branch length (default: the family's, 1 or 4).
+        #[arg(long)]
+        b_min: Option<usize>,
+        /// Largest branch length (default: the family's, 10 or 8).
+        #[arg(long)]
+        b_max: Option<usize>,
         /// Override the model's connector pressure (kPa).
         #[arg(long)]
         pressure: Option<f64>,
@@ -286,6 +290,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
         Command::BStudy {
             family,
             model,
+            size,
             b_min,
             b_max,
             pressure,
@@ -301,10 +306,12 @@ fn run(cmd: Command) -> Result<u8, Failure> {
                     bending.unwrap_or(m.connector.bending),
                 );
             }
+            let (lo, hi) = b_study::default_range(&family);
+            let (b_min, b_max) = (b_min.unwrap_or(lo), b_max.unwrap_or(hi));
             if b_min == 0 || b_min > b_max {
                 return Err(InputError::new(format!("bad range of b: {b_min}..={b_max}")).into());
             }
-            let generate = b_study::family(&family, m.spacing * 1e3)?;
+            let generate = b_study::family(&family, m.spacing * 1e3, size)?;
             let lengths: Vec<usize> = (b_min..=b_max).collect();
             let st = b_study::b_study(&family, &m, &lengths, generate)?;
             print!("{}", st.table());

@@ -308,3 +308,118 @@ fn the_mechanics_check_runs_on_square_lattice_schedules_with_a_model() {
         .fold(0.0, f64::max);
     assert!(max > 0.0 && max < 1.0, "max utilisation {max}");
 }
+
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.len() > 1000,
+        "{} is {} bytes",
+        path.display(),
+        bytes.len()
+    );
+    assert_eq!(&bytes[1..4], b"PNG", "{}", path.display());
+}
+
+#[test]
+fn b_study_of_the_pyramid_family_writes_a_table_a_plot_and_json() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let png = scratch("b-pyramid.png");
+    let json = scratch("b-pyramid.json");
+    let o = bin()
+        .arg("b-study")
+        .args(["--family", "pyramid", "--b-min", "4", "--b-max", "5"])
+        .arg("--model")
+        .arg(root.join("models/catom-3.6mm.toml"))
+        .arg("--plot")
+        .arg(&png)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("family 'pyramid'"), "{table}");
+    assert!(table.contains("largest safe b at 100 kPa"), "{table}");
+    assert_png(&png);
+    let st: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let rows = st["rows"].as_array().unwrap();
+    assert_eq!(
+        rows.iter()
+            .map(|r| r["b"].as_u64().unwrap())
+            .collect::<Vec<_>>(),
+        [4, 5]
+    );
+    for r in rows {
+        assert_eq!(r["lattice_violations"], 0, "{r}");
+        let u = r["max_utilisation"].as_f64().unwrap();
+        assert!(u > 0.0 && u < 1.0, "{r}");
+    }
+    assert_eq!(st["b_max"], 5);
+}
+
+#[test]
+fn b_study_refuses_an_unknown_family_and_a_too_short_scaffold_branch() {
+    let o = bin()
+        .args(["b-study", "--family", "torus"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pyramid"), "{}", stderr(&o));
+    let o = bin()
+        .args([
+            "b-study", "--family", "cube", "--b-min", "3", "--b-max", "3",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("b ≥ 4"), "{}", stderr(&o));
+}
+
+#[test]
+fn loadmap_draws_a_scaffold_step_and_names_its_critical_connector() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scenario = write(
+        "p2b6.toml",
+        "name = \"p2b6\"\nalgorithm = \"scaffold\"\n[parameters]\nshape = \"pyramid\"\nh = 2\nb = 6\n",
+    );
+    let schedule = scratch("p2b6.json");
+    let o = bin()
+        .arg("generate")
+        .arg(&scenario)
+        .arg("-o")
+        .arg(&schedule)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let png = scratch("p2b6-loadmap.png");
+    let o = bin()
+        .arg("loadmap")
+        .arg(&schedule)
+        .args(["--step", "52"])
+        .arg("--model")
+        .arg(root.join("models/catom-3.6mm.toml"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let summary = String::from_utf8_lossy(&o.stdout);
+    // The b-study's worst step of this pyramid: the first connector of a
+    // horizontal branch of b = 6 carries (b − 2)(b − 1)/2 = 10 module
+    // weights times d, 0.347 of the 100 kPa rigid-hinge capacity.
+    assert!(summary.contains("step 52"), "{summary}");
+    assert!(summary.contains("max utilisation 0.3469"), "{summary}");
+    assert_png(&png);
+    // A step beyond the final configuration is unusable input.
+    let o = bin()
+        .arg("loadmap")
+        .arg(&schedule)
+        .args(["--step", "100000"])
+        .arg("--model")
+        .arg(root.join("models/catom-3.6mm.toml"))
+        .arg("-o")
+        .arg(scratch("never.png"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

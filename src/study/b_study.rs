@@ -85,13 +85,45 @@ pub struct Study {
 pub type FamilyFn = Box<dyn Fn(usize) -> Result<Schedule, InputError>>;
 
 /// The shape families `reconfcheck b-study --family` knows, each a
-/// schedule generator over `b` at lattice spacing `spacing_mm`. To add one
-/// (e.g. seed 000's `pyramid` or `cube` scaffolds), add an arm here that
-/// calls its generator with the branch length.
-pub fn family(name: &str, spacing_mm: f64) -> Result<FamilyFn, InputError> {
+/// schedule generator over `b` at lattice spacing `spacing_mm`:
+///
+/// * `branch` — one horizontal branch of `b` modules grown from a fixed
+///   base, agent by agent (the worst cantilever, built);
+/// * `pyramid` — seed 000's scaffold of an `size`-pyramid (default 2),
+///   assembled from the sandbox with branch length `b`;
+/// * `cube` — seed 000's scaffold of the cube of `size` tiles a side
+///   (default 2), side `(size − 1)·b + e` modules with `e = b − 1` (border
+///   branches of `b − 2` modules). Not the generator's default `e = b`:
+///   with it the planner finds no route for one module of the 2-tile cube
+///   at `b = 4`; `e = b − 1` plans for every `b` from 4 to 10.
+///
+/// `size` is ignored by `branch`. Scaffold families need `b ≥ 4`
+/// (seed 000 §3.2.2); the generator says so for smaller `b`.
+pub fn family(name: &str, spacing_mm: f64, size: Option<u32>) -> Result<FamilyFn, InputError> {
+    use crate::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
+    let h = size.unwrap_or(2);
+    if h == 0 {
+        return Err(InputError::new(
+            "b-study: the shape size must be at least 1",
+        ));
+    }
+    let scaffold = move |shape: ShapeSpec, b: usize| -> Result<Schedule, InputError> {
+        let b = u32::try_from(b).map_err(|_| InputError::new(format!("b = {b} is too large")))?;
+        let mut s = scaffold_schedule(&shape, b)?;
+        s.spacing = crate::schedule::Length::mm(spacing_mm);
+        Ok(s)
+    };
     match name {
         "branch" => Ok(Box::new(move |b| {
             crate::algorithms::branch::branch_schedule(b, spacing_mm)
+        })),
+        "pyramid" => Ok(Box::new(move |b| scaffold(ShapeSpec::Pyramid { h }, b))),
+        "cube" => Ok(Box::new(move |b| {
+            let e = u32::try_from(b)
+                .unwrap_or(u32::MAX)
+                .saturating_sub(1)
+                .max(1);
+            scaffold(ShapeSpec::Cube { h, e }, b)
         })),
         other => Err(InputError::new(format!(
             "unknown b-study family '{other}' (known: {})",
@@ -101,7 +133,16 @@ pub fn family(name: &str, spacing_mm: f64) -> Result<FamilyFn, InputError> {
 }
 
 /// Names accepted by [`family`].
-pub const FAMILIES: &[&str] = &["branch"];
+pub const FAMILIES: &[&str] = &["branch", "pyramid", "cube"];
+
+/// The range of `b` a family is studied over by default: the branch from
+/// 1, seed 000's scaffolds from their smallest branch length, 4.
+pub fn default_range(name: &str) -> (usize, usize) {
+    match name {
+        "branch" => (1, 10),
+        _ => (4, 8),
+    }
+}
 
 /// Pressures of the sweep (kPa): 1…150, SPEC §7.
 pub fn sweep_pressures() -> Vec<f64> {
@@ -330,6 +371,7 @@ impl Study {
             root.fill(&WHITE).map_err(|e| e.to_string())?;
             let (left, right) = root.split_horizontally(600);
             let bmax = self.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 0.5;
+            let bmin = self.rows.iter().map(|r| r.b).min().unwrap_or(1) as f64 - 0.5;
             let umax = self
                 .rows
                 .iter()
@@ -349,7 +391,7 @@ impl Study {
                 .margin(12)
                 .x_label_area_size(40)
                 .y_label_area_size(55)
-                .build_cartesian_2d(0.5..bmax, 0.0..umax)
+                .build_cartesian_2d(bmin..bmax, 0.0..umax)
                 .map_err(|e| e.to_string())?;
             c.configure_mesh()
                 .x_desc("branch length b (modules)")
@@ -357,7 +399,7 @@ impl Study {
                 .draw()
                 .map_err(|e| e.to_string())?;
             c.draw_series(LineSeries::new(
-                [(0.5, 1.0), (bmax, 1.0)],
+                [(bmin, 1.0), (bmax, 1.0)],
                 BLACK.stroke_width(1),
             ))
             .map_err(|e| e.to_string())?;
@@ -407,7 +449,7 @@ impl Study {
                 .margin(12)
                 .x_label_area_size(40)
                 .y_label_area_size(55)
-                .build_cartesian_2d(0.5..bmax, (0.1..pmax).log_scale())
+                .build_cartesian_2d(bmin..bmax, (0.1..pmax).log_scale())
                 .map_err(|e| e.to_string())?;
             c.configure_mesh()
                 .x_desc("branch length b (modules)")
@@ -419,13 +461,13 @@ impl Study {
                 (133.0, "ideal parallel plate 133 kPa"),
             ] {
                 c.draw_series(LineSeries::new(
-                    [(0.5, kpa), (bmax, kpa)],
+                    [(bmin, kpa), (bmax, kpa)],
                     BLACK.mix(0.5).stroke_width(1),
                 ))
                 .map_err(|e| e.to_string())?;
                 c.draw_series(std::iter::once(Text::new(
                     label,
-                    (0.7, kpa * 1.08),
+                    (bmin + 0.2, kpa * 1.08),
                     ("sans-serif", 12),
                 )))
                 .map_err(|e| e.to_string())?;
@@ -519,6 +561,78 @@ mod tests {
                 .windows(2)
                 .all(|w| w[0].b_max_rigid_hinge <= w[1].b_max_rigid_hinge)
         );
+    }
+
+    #[test]
+    fn the_pyramid_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
+        let model = Model::default_catom();
+        let generate = family("pyramid", 3.6, None).unwrap();
+        let st = b_study("pyramid", &model, &[4, 5, 6], generate).unwrap();
+        assert_eq!(st.rows.len(), 3);
+        for r in &st.rows {
+            assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
+            assert!(!r.no_equilibrium && r.steps > 0, "b = {}", r.b);
+        }
+        assert!(
+            st.rows
+                .windows(2)
+                .all(|w| w[1].max_utilisation > w[0].max_utilisation),
+            "{:?}",
+            st.rows
+                .iter()
+                .map(|r| r.max_utilisation)
+                .collect::<Vec<_>>()
+        );
+        // From b = 5 the worst connector is the one between the first and
+        // second module of a finished horizontal branch: b − 2 modules
+        // beyond it, the closed-form moment of b − 3 modules plus an agent.
+        for r in &st.rows[1..] {
+            let expected = closed_form::cantilever_utilisation(&model, r.b - 3, true);
+            assert!(
+                (r.max_utilisation - expected).abs() < 1e-6 * expected,
+                "b = {}: {} vs {expected}",
+                r.b,
+                r.max_utilisation
+            );
+        }
+        // Every b here holds at the default 100 kPa.
+        assert_eq!(st.b_max, 6);
+    }
+
+    #[test]
+    fn the_cube_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
+        let model = Model::default_catom();
+        let generate = family("cube", 3.6, None).unwrap();
+        let st = b_study("cube", &model, &[4, 5], generate).unwrap();
+        for r in &st.rows {
+            assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
+            assert!(!r.no_equilibrium, "b = {}", r.b);
+        }
+        assert!(st.rows[1].max_utilisation > st.rows[0].max_utilisation);
+        // A cube of 2 tiles a side holds more modules than the 2-pyramid of
+        // equal b, and more as b grows.
+        let modules = |f: &str, b: usize| {
+            family(f, 3.6, None).unwrap()(b).unwrap().meta["scaffold_modules"]
+                .as_u64()
+                .unwrap()
+        };
+        assert!(modules("cube", 4) > modules("pyramid", 4));
+        assert!(modules("cube", 5) > modules("cube", 4));
+    }
+
+    #[test]
+    fn scaffold_families_take_the_size_and_refuse_bad_input() {
+        let small = family("pyramid", 3.6, Some(1)).unwrap()(4).unwrap();
+        let large = family("pyramid", 3.6, Some(2)).unwrap()(4).unwrap();
+        assert!(small.steps.len() < large.steps.len());
+        // The model's spacing is carried into the schedule.
+        let s = family("pyramid", 2.0, Some(1)).unwrap()(4).unwrap();
+        assert!((s.spacing.metres() - 2e-3).abs() < 1e-12);
+        // Seed 000 needs b ≥ 4; size 0 and unknown families are refused.
+        assert!(family("pyramid", 3.6, None).unwrap()(3).is_err());
+        assert!(family("cube", 3.6, Some(0)).is_err());
+        let e = family("torus", 3.6, None).err().unwrap();
+        assert!(e.to_string().contains("pyramid"), "{e}");
     }
 
     #[test]
