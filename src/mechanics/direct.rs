@@ -11,12 +11,11 @@
 use super::solver::{BlockMatrix, Vec6};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+    LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
 /// The Cholesky factor `K = LLᵀ` of a symmetric positive definite block
@@ -24,39 +23,36 @@ use faer::{Conj, MatMut, Par, Side};
 pub struct Factor {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
-    blocks: usize,
+    /// `order[new] = old` block index.
+    order: Vec<usize>,
 }
 
 impl std::fmt::Debug for Factor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Factor")
-            .field("blocks", &self.blocks)
+            .field("blocks", &self.order.len())
             .field("nnz_l", &self.values.len())
             .finish()
     }
 }
 
-/// A fill-reducing ordering of the scalar unknowns from approximate
-/// minimum degree on the block graph (one node per module): 36 times
-/// fewer entries to order than the scalar pattern, and a module's six
-/// unknowns stay together.
-fn block_ordering(k: &BlockMatrix) -> Option<(Vec<usize>, Vec<usize>)> {
-    let n = k.len();
-    let mut idx: Vec<(usize, usize)> = (0..n).map(|i| (i, i)).collect();
-    idx.extend(k.off.iter().map(|(i, j, _)| (*i as usize, *j as usize)));
-    idx.sort_unstable_by_key(|&(r, c)| (c, r));
-    idx.dedup();
-    let mut col_ptr = vec![0usize; n + 1];
-    for &(_, c) in &idx {
-        col_ptr[c + 1] += 1;
+/// A fill-reducing ordering of the modules: approximate minimum degree on
+/// the block graph (one node per module) — 36 times fewer entries to order
+/// than the scalar pattern, and a module's six unknowns stay together.
+/// Returns `order[new] = old` and its inverse.
+fn block_ordering(n: usize, adjacency: &[Vec<(usize, usize)>]) -> Option<(Vec<usize>, Vec<usize>)> {
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut rows = Vec::new();
+    col_ptr.push(0);
+    for (c, adj) in adjacency.iter().enumerate() {
+        // Upper triangle, sorted: the neighbours above the diagonal, then it.
+        rows.extend(adj.iter().map(|&(j, _)| j).filter(|&j| j < c));
+        rows.push(c);
+        col_ptr.push(rows.len());
     }
-    for c in 0..n {
-        col_ptr[c + 1] += col_ptr[c];
-    }
-    let rows: Vec<usize> = idx.iter().map(|&(r, _)| r).collect();
     let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
     let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
-    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n, idx.len())).ok()?;
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(n, pattern.compute_nnz())).ok()?;
     amd::order(
         &mut fwd,
         &mut inv,
@@ -65,62 +61,77 @@ fn block_ordering(k: &BlockMatrix) -> Option<(Vec<usize>, Vec<usize>)> {
         MemStack::new(&mut mem),
     )
     .ok()?;
-    let fwd6: Vec<usize> = fwd
-        .iter()
-        .flat_map(|&b| (0..6).map(move |r| 6 * b + r))
-        .collect();
-    let mut inv6 = vec![0usize; 6 * n];
-    for (k, &o) in fwd6.iter().enumerate() {
-        inv6[o] = k;
-    }
-    Some((fwd6, inv6))
+    Some((fwd, inv))
 }
 
 impl Factor {
     /// Factors `k`; `None` when it is not positive definite (a part of the
     /// structure is free to move: a mechanism).
+    ///
+    /// The upper triangle of `PKPᵀ` (P: the block ordering) is written
+    /// straight into compressed columns, sorted, so faer neither sorts
+    /// triplets nor permutes the matrix again.
     pub fn new(k: &BlockMatrix) -> Option<Factor> {
         let n = k.len();
-        let mut entries: Vec<Triplet<usize, usize, f64>> =
-            Vec::with_capacity(21 * n + 36 * k.off.len());
-        for (i, d) in k.diag.iter().enumerate() {
-            for c in 0..6 {
-                for r in c..6 {
-                    entries.push(Triplet::new(6 * i + r, 6 * i + c, d[(r, c)]));
+        // Neighbours of each block with the index of their `off` entry,
+        // sorted by block index.
+        let mut adjacency: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+        for (e, (i, j, _)) in k.off.iter().enumerate() {
+            adjacency[*i as usize].push((*j as usize, e));
+            adjacency[*j as usize].push((*i as usize, e));
+        }
+        adjacency.iter_mut().for_each(|a| a.sort_unstable());
+        let (order, position) = block_ordering(n, &adjacency)?;
+        let mut col_ptr = Vec::with_capacity(6 * n + 1);
+        let mut rows = Vec::with_capacity(21 * n + 36 * k.off.len());
+        let mut values = Vec::with_capacity(rows.capacity());
+        col_ptr.push(0);
+        let mut above: Vec<(usize, usize)> = Vec::new();
+        for (c, &o) in order.iter().enumerate() {
+            above.clear();
+            above.extend(
+                adjacency[o]
+                    .iter()
+                    .map(|&(j, e)| (position[j], e))
+                    .filter(|&(r, _)| r < c),
+            );
+            above.sort_unstable();
+            for cc in 0..6 {
+                for &(rb, e) in &above {
+                    // Block (row rb, column c) of PKPᵀ is K[order[rb], o].
+                    let (i, _, b) = &k.off[e];
+                    let from_row = *i as usize == order[rb];
+                    for r in 0..6 {
+                        rows.push(6 * rb + r);
+                        values.push(if from_row { b[(r, cc)] } else { b[(cc, r)] });
+                    }
                 }
+                for r in 0..=cc {
+                    rows.push(6 * c + r);
+                    values.push(k.diag[o][(r, cc)]);
+                }
+                col_ptr.push(rows.len());
             }
         }
-        // `off` holds K_ij for i < j; its lower-triangle mirror is
-        // K_ji = K_ijᵀ at block row j, block column i.
-        for (i, j, b) in &k.off {
-            let (i, j) = (*i as usize, *j as usize);
-            debug_assert!(i < j);
-            for c in 0..6 {
-                for r in 0..6 {
-                    entries.push(Triplet::new(6 * j + r, 6 * i + c, b[(c, r)]));
-                }
-            }
-        }
-        let mat = SparseColMat::<usize, f64>::try_new_from_triplets(6 * n, 6 * n, &entries).ok()?;
-        let (fwd, inv) = block_ordering(k)?;
-        let perm = PermRef::new_checked(&fwd, &inv, 6 * n);
+        let pattern = SymbolicSparseColMat::new_checked(6 * n, 6 * n, col_ptr, None, rows);
+        let mat = SparseColMat::new(pattern, values);
         let symbolic = factorize_symbolic_cholesky(
             mat.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Custom(perm),
+            Side::Upper,
+            SymmetricOrdering::Identity,
             Default::default(),
         )
         .ok()?;
-        let mut values = vec![0.0; symbolic.len_val()];
+        let mut l = vec![0.0; symbolic.len_val()];
         let mut mem = MemBuffer::try_new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         )
         .ok()?;
         symbolic
             .factorize_numeric_llt::<f64>(
-                &mut values,
+                &mut l,
                 mat.as_ref(),
-                Side::Lower,
+                Side::Upper,
                 LltRegularization::default(),
                 Par::Seq,
                 MemStack::new(&mut mem),
@@ -129,36 +140,39 @@ impl Factor {
             .ok()?;
         Some(Factor {
             symbolic,
-            values,
-            blocks: n,
+            values: l,
+            order,
         })
     }
 
     /// Number of 6 × 6 block rows.
     pub fn len(&self) -> usize {
-        self.blocks
+        self.order.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.blocks == 0
+        self.order.is_empty()
     }
 
     /// Solves `K x = b` in place (`b` has one block per row of `K`).
     pub fn solve_in_place(&self, b: &mut [Vec6]) {
-        assert_eq!(b.len(), self.blocks, "right-hand side size");
-        // Vector6<f64> is six contiguous f64 (nalgebra's column-major
-        // array storage), so the blocks are one column of 6n values.
-        let flat: &mut [f64] =
-            unsafe { std::slice::from_raw_parts_mut(b.as_mut_ptr().cast::<f64>(), 6 * b.len()) };
-        let n = flat.len();
+        assert_eq!(b.len(), self.len(), "right-hand side size");
+        let mut y: Vec<f64> = self
+            .order
+            .iter()
+            .flat_map(|&o| b[o].iter().copied())
+            .collect();
+        let n = y.len();
         let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        faer::sparse::linalg::cholesky::LltRef::new(&self.symbolic, &self.values)
-            .solve_in_place_with_conj(
-                Conj::No,
-                MatMut::from_column_major_slice_mut(flat, n, 1),
-                Par::Seq,
-                MemStack::new(&mut mem),
-            );
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut y, n, 1),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
+        for (c, &o) in self.order.iter().enumerate() {
+            b[o] = Vec6::from_column_slice(&y[6 * c..6 * c + 6]);
+        }
     }
 }
 
