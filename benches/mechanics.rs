@@ -1,7 +1,8 @@
 //! Speed of the mechanical check (issue #4 item 6): replaying a schedule's
 //! every intermediate structure with reuse between steps (`incremental`:
-//! unchanged components kept, changed ones warm-started) against solving
-//! every step from scratch.
+//! each component's sparse Cholesky factor is kept and preconditions CG,
+//! warm-started, while only its loads or at most one body changed) against
+//! factoring every step from scratch.
 //!
 //! `cargo bench --bench mechanics`
 //!

@@ -19,15 +19,14 @@ fn main() {
     );
     let m = Model::default_catom();
     let t = Instant::now();
-    let (mut its, mut solved, mut reused) = (0, 0, 0);
+    let (mut its, mut factorizations) = (0, 0);
     replay(&s, &m, a[5] != 0, |_, _, r, _| {
         its += r.iterations;
-        solved += r.factorizations;
-        reused += 0;
+        factorizations += r.factorizations;
     })
     .unwrap();
     println!(
-        "{} modules, {} steps: {:.2}s, CG iterations {its}, components solved {solved}, reused {reused}",
+        "{} modules, {} steps: {:.2}s, CG iterations {its}, factorisations {factorizations}",
         s.modules.len(),
         s.steps.len(),
         t.elapsed().as_secs_f64()

@@ -1,4 +1,6 @@
-//! Probe: per-step statistics of a scenario's mechanical replay.
+//! Probe: per-step statistics of a scenario's mechanical replay (bodies,
+//! links, movers, bodies added/removed, factorisations, CG iterations).
+//! `cargo run --release --example mech_stats -- SCENARIO [INCREMENTAL(1|0)] [STEPS]`
 use reconfcheck::certify::load_check::replay;
 use reconfcheck::mechanics::Model;
 use reconfcheck::scenario::Scenario;
@@ -38,12 +40,11 @@ fn main() {
         tot_its += a.iterations;
         if k % 50 == 0 || k < 5 {
             println!(
-                "step {k}: free {} links {} hanging {} +{added} -{removed} factorizations {} _{} its {} max_u {:.3} dt {:.3}s",
+                "step {k}: free {} links {} hanging {} +{added} -{removed} factorisations {} its {} max_u {:.3} dt {:.3}s",
                 cur.len(),
                 st.links.len(),
                 st.hanging.len(),
                 a.factorizations,
-                0,
                 a.iterations,
                 a.max_utilisation,
                 last.elapsed().as_secs_f64()

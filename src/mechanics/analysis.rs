@@ -250,7 +250,10 @@ pub struct Analyzer {
     springs: Springs,
     ground_springs: Springs,
     warm: FxHashMap<BodyKey, Vec6>,
-    reference: Option<Reference>,
+    /// One kept factor per component of the last step, and which one
+    /// holds each body.
+    references: Vec<Reference>,
+    owner: FxHashMap<BodyKey, u32>,
     blocks: FxHashMap<([u64; 3], bool, bool), LinkBlocks>,
 }
 
@@ -265,7 +268,8 @@ impl Analyzer {
             springs,
             ground_springs,
             warm: FxHashMap::default(),
-            reference: None,
+            references: Vec::new(),
+            owner: FxHashMap::default(),
             blocks: FxHashMap::default(),
         }
     }
@@ -273,7 +277,8 @@ impl Analyzer {
     /// Forgets what earlier steps left (factor and displacements).
     pub fn reset(&mut self) {
         self.warm.clear();
-        self.reference = None;
+        self.references.clear();
+        self.owner.clear();
     }
 
     /// The stiffness blocks of a link (cached by geometry: every link of a
@@ -335,117 +340,133 @@ impl Analyzer {
         // Displacements of every free body (zeros where unsupported).
         let mut q_all = vec![Vec6::zeros(); nb];
         let mut anchored = vec![false; comps.count];
-        let mut warm_started = false;
-        for _round in 0..=self.settings.max_release_rounds {
-            // A component stands while some link ties it to the ground or
-            // to a fixed module.
-            anchored.iter_mut().for_each(|a| *a = false);
-            for (li, l) in s.links.iter().enumerate() {
-                if released[li] {
-                    continue;
-                }
-                let (ca, cb) = (comps.of(s, End::Body(l.a)), comps.of(s, l.b));
-                match (ca, cb) {
-                    (Some(c), None) | (None, Some(c)) => anchored[c] = true,
-                    _ => {}
-                }
-            }
-            let active: Vec<usize> = (0..nb)
-                .filter(|&b| comps.of(s, End::Body(b)).is_some_and(|c| anchored[c]))
-                .collect();
-            let mut local = vec![u32::MAX; nb];
-            for (k, &b) in active.iter().enumerate() {
+        let mut local = vec![u32::MAX; nb];
+        // The kept factors, looked up by body; this step's replace them.
+        let mut kept: Vec<Option<Reference>> = std::mem::take(&mut self.references)
+            .into_iter()
+            .map(Some)
+            .collect();
+        let owner = std::mem::take(&mut self.owner);
+        for c in 0..comps.count {
+            let bodies = &comps.bodies[c];
+            let links = &comps.links[c];
+            for (k, &b) in bodies.iter().enumerate() {
                 local[b] = k as u32;
             }
-            let k = self.assemble(s, &local, &released, &sliding, active.len());
-            let f: Vec<Vec6> = active.iter().map(|&b| loads[b]).collect();
-            let mut q: Vec<Vec6> = if warm_started || !self.incremental {
-                active.iter().map(|&b| q_all[b]).collect()
-            } else {
-                active
+            let f: Vec<Vec6> = bodies.iter().map(|&b| loads[b]).collect();
+            let mut q: Vec<Vec6> = bodies
+                .iter()
+                .map(|&b| {
+                    self.warm
+                        .get(&key(&s.bodies[b]))
+                        .copied()
+                        .unwrap_or_else(Vec6::zeros)
+                })
+                .collect();
+            let mut reference = if self.incremental {
+                bodies
                     .iter()
-                    .map(|&b| {
-                        self.warm
-                            .get(&key(&s.bodies[b]))
-                            .copied()
-                            .unwrap_or_else(Vec6::zeros)
-                    })
-                    .collect()
+                    .find_map(|&b| owner.get(&key(&s.bodies[b])))
+                    .and_then(|&r| kept[r as usize].take())
+            } else {
+                None
             };
-            warm_started = true;
-            self.solve(s, &active, &k, &f, &mut q, &mut out);
-            for (i, &b) in active.iter().enumerate() {
-                q_all[b] = q[i];
-            }
-            // Ground contacts pulled or tipped beyond their edge let go;
-            // failing that, those beyond their friction slide.
-            let mut lift = Vec::new();
-            let mut slide = Vec::new();
-            for (li, l) in s.links.iter().enumerate() {
-                if !l.is_ground() || released[li] || local[l.a] == u32::MAX {
-                    continue;
+            for _round in 0..=self.settings.max_release_rounds {
+                // The component stands while some link ties it to the
+                // ground or to a fixed module.
+                anchored[c] = links.iter().any(|&li| {
+                    !released[li]
+                        && (comps.of(s, End::Body(s.links[li].a)).is_none()
+                            || comps.of(s, s.links[li].b).is_none())
+                });
+                if !anchored[c] {
+                    break;
                 }
-                let load = self.link_forces(s, l, &q_all, sliding[li]).0;
-                let (u, mode) = utilisation(&load, &self.model.ground);
-                if u > 1.0 + 1e-9 {
-                    match mode {
-                        Mode::Bending => lift.push(li),
-                        Mode::Friction if !sliding[li] => slide.push(li),
-                        Mode::Friction => {}
+                let k = self.assemble(s, links, &local, &released, &sliding, bodies.len());
+                self.solve(s, bodies, &k, &f, &mut q, &mut reference, &mut out);
+                for (i, &b) in bodies.iter().enumerate() {
+                    q_all[b] = q[i];
+                }
+                // Ground contacts pulled or tipped beyond their edge let
+                // go; failing that, those beyond their friction slide.
+                let mut lift = Vec::new();
+                let mut slide = Vec::new();
+                for &li in links {
+                    let l = &s.links[li];
+                    if !l.is_ground() || released[li] {
+                        continue;
+                    }
+                    let load = self.link_forces(s, l, &q_all, sliding[li]).0;
+                    let (u, mode) = utilisation(&load, &self.model.ground);
+                    if u > 1.0 + 1e-9 {
+                        match mode {
+                            Mode::Bending => lift.push(li),
+                            Mode::Friction if !sliding[li] => slide.push(li),
+                            Mode::Friction => {}
+                        }
                     }
                 }
+                if !lift.is_empty() {
+                    lift.into_iter().for_each(|li| released[li] = true);
+                } else if !slide.is_empty() {
+                    slide.into_iter().for_each(|li| sliding[li] = true);
+                } else {
+                    break;
+                }
             }
-            if !lift.is_empty() {
-                lift.into_iter().for_each(|li| released[li] = true);
-            } else if !slide.is_empty() {
-                slide.into_iter().for_each(|li| sliding[li] = true);
-            } else {
-                break;
+            for &b in bodies {
+                local[b] = u32::MAX;
+            }
+            if !anchored[c] {
+                bodies.iter().for_each(|&b| q_all[b] = Vec6::zeros());
+            }
+            if let Some(r) = reference {
+                self.references.push(r);
             }
         }
         if self.incremental {
             self.warm.clear();
-            for (b, body) in s.bodies.iter().enumerate() {
-                if comps.of(s, End::Body(b)).is_some_and(|c| anchored[c]) {
-                    self.warm.insert(key(body), q_all[b]);
+            for (r, reference) in self.references.iter().enumerate() {
+                for k in reference.index.keys() {
+                    self.owner.insert(*k, r as u32);
                 }
             }
         }
         let mut any_unsupported = false;
-        for b in 0..nb {
-            if comps.of(s, End::Body(b)).is_some_and(|c| !anchored[c]) {
+        for c in 0..comps.count {
+            if !anchored[c] {
                 any_unsupported = true;
-                out.unsupported.push(b);
-            }
-        }
-        for (li, l) in s.links.iter().enumerate() {
-            let side = if s.bodies[l.a].fixed {
-                l.b
-            } else {
-                End::Body(l.a)
-            };
-            if !comps.of(s, side).is_some_and(|c| anchored[c]) {
+                out.unsupported.extend(comps.bodies[c].iter().copied());
                 continue;
             }
-            out.links[li] = if released[li] {
-                LinkResult {
-                    released: true,
-                    ..Default::default()
+            if self.incremental {
+                for &b in &comps.bodies[c] {
+                    self.warm.insert(key(&s.bodies[b]), q_all[b]);
                 }
-            } else {
-                let (load, force, moment) = self.link_forces(s, l, &q_all, sliding[li]);
-                let (u, m) = utilisation(&load, self.capacity(l));
-                LinkResult {
-                    load,
-                    utilisation: u,
-                    mode: Some(m),
-                    released: false,
-                    sliding: sliding[li],
-                    force: force.to_array(),
-                    moment: moment.to_array(),
-                }
-            };
+            }
+            for &li in &comps.links[c] {
+                let l = &s.links[li];
+                out.links[li] = if released[li] {
+                    LinkResult {
+                        released: true,
+                        ..Default::default()
+                    }
+                } else {
+                    let (load, force, moment) = self.link_forces(s, l, &q_all, sliding[li]);
+                    let (u, m) = utilisation(&load, self.capacity(l));
+                    LinkResult {
+                        load,
+                        utilisation: u,
+                        mode: Some(m),
+                        released: false,
+                        sliding: sliding[li],
+                        force: force.to_array(),
+                        moment: moment.to_array(),
+                    }
+                };
+            }
         }
+        out.unsupported.sort_unstable();
 
         // The connector holding each mover on its pivot.
         let w = self.model.weight();
@@ -572,10 +593,11 @@ impl Analyzer {
         (load, -f * w, -m * wd)
     }
 
-    /// The stiffness matrix over the bodies with a `local` index.
+    /// The stiffness matrix of `links` over the bodies with a `local` index.
     fn assemble(
         &mut self,
         s: &Structure,
+        links: &[usize],
         local: &[u32],
         released: &[bool],
         sliding: &[bool],
@@ -587,7 +609,8 @@ impl Analyzer {
             End::Body(b) if local[b] != u32::MAX => Some(local[b] as usize),
             _ => None,
         };
-        for (li, l) in s.links.iter().enumerate() {
+        for &li in links {
+            let l = &s.links[li];
             let (ia, ib) = (side(End::Body(l.a)), side(l.b));
             if released[li] || (ia.is_none() && ib.is_none()) {
                 continue;
@@ -610,9 +633,11 @@ impl Analyzer {
         k
     }
 
-    /// Solves `K q = f` over the `active` bodies: by a fresh factor, or
-    /// (incrementally) by CG preconditioned with the kept factor, falling
-    /// back to a fresh factor when that does not converge quickly.
+    /// Solves `K q = f` over one component's `active` bodies: by a fresh
+    /// factor, or (incrementally) by CG preconditioned with the component's
+    /// kept factor `reference`, falling back to a fresh factor — which then
+    /// becomes the kept one — when that does not converge quickly.
+    #[allow(clippy::too_many_arguments)]
     fn solve(
         &mut self,
         s: &Structure,
@@ -620,6 +645,7 @@ impl Analyzer {
         k: &BlockMatrix,
         f: &[Vec6],
         q: &mut [Vec6],
+        reference: &mut Option<Reference>,
         out: &mut Analysis,
     ) {
         if k.is_empty() {
@@ -627,7 +653,7 @@ impl Analyzer {
         }
         let tol = self.settings.tolerance;
         if self.incremental {
-            if let Some(r) = &self.reference {
+            if let Some(r) = reference.as_ref() {
                 let map: Vec<u32> = active
                     .iter()
                     .map(|&b| r.index.get(&key(&s.bodies[b])).copied().unwrap_or(u32::MAX))
@@ -666,7 +692,7 @@ impl Analyzer {
                         .enumerate()
                         .map(|(i, &b)| (key(&s.bodies[b]), i as u32))
                         .collect();
-                    self.reference = Some(Reference { factor, index });
+                    *reference = Some(Reference { factor, index });
                 }
             }
             None => {
@@ -683,6 +709,9 @@ impl Analyzer {
 struct Components {
     of: Vec<u32>,
     count: usize,
+    /// Bodies and links (by the free side) of each component.
+    bodies: Vec<Vec<usize>>,
+    links: Vec<Vec<usize>>,
 }
 
 impl Components {
@@ -720,7 +749,30 @@ impl Components {
             }
             of[i] = id[r];
         }
-        Components { of, count }
+        let mut bodies = vec![Vec::new(); count];
+        for i in 0..nb {
+            if of[i] != u32::MAX {
+                bodies[of[i] as usize].push(i);
+            }
+        }
+        let mut links = vec![Vec::new(); count];
+        for (li, l) in s.links.iter().enumerate() {
+            let side = if s.bodies[l.a].fixed {
+                match l.b {
+                    End::Body(b) if !s.bodies[b].fixed => b,
+                    _ => continue,
+                }
+            } else {
+                l.a
+            };
+            links[of[side] as usize].push(li);
+        }
+        Components {
+            of,
+            count,
+            bodies,
+            links,
+        }
     }
 
     /// The component of a link end: `None` for fixed bodies and the ground.
