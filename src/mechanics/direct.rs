@@ -183,25 +183,11 @@ mod tests {
 
     #[test]
     fn the_factor_solves_a_coupled_block_chain_exactly() {
-        let n = 7;
-        let mut k = BlockMatrix::new(n);
-        for i in 0..n {
-            k.diag[i] = Block::identity() * 4.0;
-            k.diag[i][(0, 1)] = 0.5;
-            k.diag[i][(1, 0)] = 0.5;
-        }
-        for i in 0..n - 1 {
-            let mut b = -Block::identity();
-            b[(2, 4)] = 0.25; // not symmetric within the block
-            k.off.push((i as u32, i as u32 + 1, b));
-        }
-        let truth: Vec<Vec6> = (0..n)
-            .map(|i| Vec6::from_fn(|r, _| (i * 6 + r) as f64 - 10.0))
-            .collect();
-        let mut x = vec![Vec6::zeros(); n];
+        let (k, truth) = crate::mechanics::solver::tests::chain(7, 0.25);
+        let mut x = vec![Vec6::zeros(); 7];
         k.mul(&truth, &mut x);
         Factor::new(&k).expect("SPD").solve_in_place(&mut x);
-        for i in 0..n {
+        for i in 0..7 {
             assert!((x[i] - truth[i]).norm() < 1e-10, "{i}: {:?}", x[i]);
         }
     }

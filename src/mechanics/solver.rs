@@ -154,13 +154,13 @@ pub fn jacobi_pcg(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    #[test]
-    fn cg_solves_a_small_spd_chain_exactly() {
-        // A chain of 5 blocks coupled to their neighbours (diagonally dominant).
-        let n = 5;
+    /// A chain of `n` blocks coupled to their neighbours (diagonally
+    /// dominant, so SPD); `skew` makes the coupling blocks unsymmetric.
+    /// Returns the matrix and a known solution.
+    pub(crate) fn chain(n: usize, skew: f64) -> (BlockMatrix, Vec<Vec6>) {
         let mut k = BlockMatrix::new(n);
         for i in 0..n {
             k.diag[i] = Block::identity() * 4.0;
@@ -168,17 +168,25 @@ mod tests {
             k.diag[i][(1, 0)] = 0.5;
         }
         for i in 0..n - 1 {
-            k.off.push((i as u32, i as u32 + 1, -Block::identity()));
+            let mut b = -Block::identity();
+            b[(2, 4)] = skew;
+            k.off.push((i as u32, i as u32 + 1, b));
         }
-        let truth: Vec<Vec6> = (0..n)
-            .map(|i| Vec6::from_fn(|r, _| (i * 6 + r) as f64))
+        let truth = (0..n)
+            .map(|i| Vec6::from_fn(|r, _| (i * 6 + r) as f64 - 10.0))
             .collect();
-        let mut f = vec![Vec6::zeros(); n];
+        (k, truth)
+    }
+
+    #[test]
+    fn cg_solves_a_small_spd_chain_exactly() {
+        let (k, truth) = chain(5, 0.0);
+        let mut f = vec![Vec6::zeros(); 5];
         k.mul(&truth, &mut f);
-        let mut x = vec![Vec6::zeros(); n];
+        let mut x = vec![Vec6::zeros(); 5];
         let s = jacobi_pcg(&k, &f, &mut x, 1e-13, 1000);
         assert!(s.converged);
-        for i in 0..n {
+        for i in 0..5 {
             assert!((x[i] - truth[i]).norm() < 1e-9);
         }
         // A warm start at the solution needs no iteration.

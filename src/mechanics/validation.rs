@@ -50,6 +50,14 @@ pub(crate) fn structure_without(
     Structure::build(&scene, movers)
 }
 
+/// The cells of an `nx × ny × nz` block of FCC cells, layer by layer
+/// (the first `nx·ny` are the bottom layer).
+fn block(nx: i32, ny: i32, nz: i32) -> Vec<Cell> {
+    (0..nz)
+        .flat_map(|z| (0..nx).flat_map(move |x| (0..ny).map(move |y| Cell::new(x, y, z))))
+        .collect()
+}
+
 fn tight(model: Model) -> Analyzer {
     let mut a = Analyzer::new(model, false);
     a.settings.tolerance = 1e-13;
@@ -151,14 +159,7 @@ fn clamped_beam_on_two_supports_matches_the_compatibility_closed_form() {
 fn reactions_balance_the_total_weight_of_an_indeterminate_block() {
     // A 3 × 3 × 3 FCC block on the ground, with a mover hanging on its top.
     let model = Model::default_catom();
-    let mut cells = Vec::new();
-    for z in 0..3 {
-        for x in 0..3 {
-            for y in 0..3 {
-                cells.push(Cell::new(x, y, z));
-            }
-        }
-    }
+    let mut cells = block(3, 3, 3);
     let mover_cell = Cell::new(3, 1, 2);
     let pivot_cell = Cell::new(2, 1, 2);
     cells.push(mover_cell);
@@ -358,14 +359,7 @@ fn the_kept_factor_and_a_fresh_one_agree_on_a_growing_block() {
     // 8 × 8 × 5 modules on a fixed layer, plus an overhanging arm grown one
     // module per step: the incremental analyser factors once and then
     // iterates with that factor, and agrees with a fresh factor every step.
-    let mut cells = Vec::new();
-    for z in 0..5 {
-        for x in 0..8 {
-            for y in 0..8 {
-                cells.push(Cell::new(x, y, z));
-            }
-        }
-    }
+    let mut cells = block(8, 8, 5);
     let fixed: Vec<usize> = (0..64).collect();
     let model = Model::default_catom();
     let mut inc = Analyzer::new(model.clone(), true);
@@ -420,14 +414,7 @@ fn a_module_leaving_and_another_arriving_are_solved_with_the_kept_factor() {
     // factored; in step 2 one top module is absent (it left) and a new one
     // sits on top elsewhere: 2 changed bodies. Allowed to, the kept factor
     // preconditions CG — and the answer is the fresh factor's.
-    let mut cells = Vec::new();
-    for z in 0..4 {
-        for x in 0..10 {
-            for y in 0..10 {
-                cells.push(Cell::new(x, y, z));
-            }
-        }
-    }
+    let mut cells = block(10, 10, 4);
     let fixed: Vec<usize> = (0..100).collect();
     let model = Model::default_catom();
     let mut inc = Analyzer::new(model.clone(), true);
