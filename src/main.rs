@@ -170,10 +170,34 @@ enum Command {
     /// (PNG, or SVG if the file name ends in .svg).
     Render {
         #[arg(value_enum)]
-        picture: reconfcheck::geometry::picture::Picture,
+        picture: PictureArg,
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+/// The pictures `render` draws (the CLI's names for
+/// [`reconfcheck::geometry::picture::Picture`], kept here so the library
+/// does not depend on the argument parser).
+#[derive(Copy, Clone, Debug, clap::ValueEnum)]
+enum PictureArg {
+    /// The catom body from three directions.
+    Body,
+    /// A 90° octagonal rotation with the cells that block it.
+    Sweep,
+    /// The deepest point of a collision, with its witness points.
+    Collision,
+}
+
+impl From<PictureArg> for reconfcheck::geometry::picture::Picture {
+    fn from(p: PictureArg) -> Self {
+        use reconfcheck::geometry::picture::Picture;
+        match p {
+            PictureArg::Body => Picture::Body,
+            PictureArg::Sweep => Picture::Sweep,
+            PictureArg::Collision => Picture::Collision,
+        }
+    }
 }
 
 enum Failure {
@@ -244,7 +268,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             Ok(0)
         }
         Command::Render { picture, output } => {
-            let svg = reconfcheck::geometry::picture::svg(picture);
+            let svg = reconfcheck::geometry::picture::svg(picture.into());
             reconfcheck::render::save(&svg, &output, 1.0).map_err(Failure::Output)?;
             eprintln!("wrote {}", output.display());
             Ok(0)

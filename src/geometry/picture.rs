@@ -14,7 +14,7 @@ use glam::{DQuat, DVec2, DVec3};
 use std::fmt::Write;
 
 /// What to draw.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Picture {
     /// The catom body from three directions.
     Body,
