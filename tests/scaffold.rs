@@ -262,3 +262,27 @@ fn concurrent_movers_of_one_step_never_collide() {
         assert!(collisions.is_empty(), "{shape:?}, b = {b}: {collisions:?}");
     }
 }
+
+/// The 2-cube at b = 4 (default e = b) used to fail mid-plan on module 241
+/// ("no sequence of rotations leads … to cell (4, 4, 7)"); b = 4 cubes are
+/// refused up front naming the parameters; e < b at h = 2, and b = 5, plan.
+#[test]
+fn dense_b4_cubes_are_refused_up_front_naming_the_parameters() {
+    let e = scaffold_schedule(&ShapeSpec::Cube { h: 2, e: 4 }, 4).unwrap_err();
+    assert!(
+        e.message.contains("b ≥ 5") && e.message.contains("b = 4") && e.message.contains("e = 4"),
+        "{}",
+        e.message
+    );
+    let e = scaffold_schedule(&ShapeSpec::Cube { h: 3, e: 2 }, 4).unwrap_err();
+    assert!(
+        e.message.contains("h = 3") && e.message.contains("e = 2"),
+        "{}",
+        e.message
+    );
+    assert!(e.module.is_none(), "refused before planning: {e:?}");
+    for (e, b) in [(3, 4), (5, 5)] {
+        let s = scaffold_schedule(&ShapeSpec::Cube { h: 2, e }, b).unwrap();
+        assert!(s.move_count() > 0);
+    }
+}
