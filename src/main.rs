@@ -234,7 +234,8 @@ fn run(cmd: Command) -> Result<u8, Failure> {
         }
         Command::Generate { scenario, output } => {
             let sc = Scenario::load(&scenario)?;
-            let s = algorithms::generate(&sc)?;
+            let mut s = algorithms::generate(&sc)?;
+            s.model = s.model.map(|m| sc.path_from(&m, &output));
             write(&output, &s.to_json())?;
             eprintln!(
                 "wrote {} ({} modules, {} steps, {} moves)",
@@ -255,6 +256,8 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             eprintln!("scenario {}: {}", sc.name, sc.description);
             let s = algorithms::generate(&sc)?;
             if let Some(out) = &output {
+                let mut s = s.clone();
+                s.model = s.model.map(|m| sc.path_from(&m, out));
                 write(out, &s.to_json())?;
             }
             certify_and_report(&s, &path, &report)

@@ -51,6 +51,41 @@ impl Scenario {
         self.dir.join(rel)
     }
 
+    /// A path written in the scenario, rewritten so that it resolves from
+    /// the folder of `output` (a file the scenario's results are written
+    /// to): relative when both lie under a common folder, else absolute.
+    /// Schedules name their model relative to their own folder, so copying
+    /// the scenario's text verbatim breaks when the output goes elsewhere.
+    pub fn path_from(&self, rel: &str, output: &Path) -> String {
+        let abs = |p: &Path| {
+            p.canonicalize()
+                .or_else(|_| std::path::absolute(p))
+                .unwrap_or_else(|_| p.to_path_buf())
+        };
+        let target = abs(&self.resolve(rel));
+        let out_dir = abs(output
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new(".")));
+        let (t, o): (Vec<_>, Vec<_>) = (
+            target.components().collect(),
+            out_dir.components().collect(),
+        );
+        let common = t.iter().zip(&o).take_while(|(a, b)| a == b).count();
+        // Only the root in common: an absolute path is clearer than "../../..".
+        if common <= 1 {
+            return target.display().to_string();
+        }
+        let mut r = PathBuf::new();
+        for _ in common..o.len() {
+            r.push("..");
+        }
+        for c in &t[common..] {
+            r.push(c);
+        }
+        r.display().to_string()
+    }
+
     /// An error about this scenario file.
     pub fn error(&self, msg: impl Into<String>) -> InputError {
         InputError::new(msg).in_file(&self.path)

@@ -423,3 +423,36 @@ fn loadmap_draws_a_scaffold_step_and_names_its_critical_connector() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// `generate` used to copy the scenario's relative `model` path verbatim;
+/// `certify` resolves it against the schedule's folder, so a schedule
+/// written elsewhere (here a temp dir) lost its model (exit 2).
+#[test]
+fn a_generated_schedule_certifies_with_its_model_from_another_folder() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = scratch("generated/pyramid-h2-b8.json");
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    let g = bin()
+        .current_dir(root)
+        .args(["generate", "scenarios/pyramid-h2-b8.toml", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(g.status.code(), Some(0), "{}", stderr(&g));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let model = s["model"].as_str().expect("the schedule names its model");
+    assert!(
+        out.parent().unwrap().join(model).is_file(),
+        "model {model} does not resolve from {}",
+        out.display()
+    );
+    let c = bin()
+        .current_dir(out.parent().unwrap())
+        .arg("certify")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&c.stdout);
+    assert_eq!(c.status.code(), Some(0), "{}{text}", stderr(&c));
+    assert!(text.contains("mechanics"), "{text}");
+}

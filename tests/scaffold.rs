@@ -236,3 +236,53 @@ fn the_plot_command_writes_a_png_of_a_scenario() {
     let png = std::fs::read(&out).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
+
+/// Two movers of one step used to sweep through the same empty cell (each
+/// legal against the structure alone): pyramid h = 2 at b = 4, 8, 9 and
+/// the 2-cube at b = 8 collided at their step 35 / 73 / 83 / 73. The
+/// planner now keeps the blocking cells of one step's rotations disjoint.
+#[test]
+fn concurrent_movers_of_one_step_never_collide() {
+    use reconfcheck::certify::ViolationKind;
+    for (shape, b) in [
+        (ShapeSpec::Pyramid { h: 2 }, 4),
+        (ShapeSpec::Pyramid { h: 2 }, 8),
+        (ShapeSpec::Pyramid { h: 2 }, 9),
+        (ShapeSpec::Cube { h: 2, e: 8 }, 8),
+    ] {
+        let s = scaffold_schedule(&shape, b).unwrap();
+        let r = certify(&s, &Options::default()).unwrap();
+        assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
+        let collisions: Vec<_> = r
+            .violations
+            .iter()
+            .filter(|v| v.kind == ViolationKind::Collision)
+            .map(|v| &v.message)
+            .collect();
+        assert!(collisions.is_empty(), "{shape:?}, b = {b}: {collisions:?}");
+    }
+}
+
+/// The 2-cube at b = 4 (default e = b) used to fail mid-plan on module 241
+/// ("no sequence of rotations leads … to cell (4, 4, 7)"); b = 4 cubes are
+/// refused up front naming the parameters; e < b at h = 2, and b = 5, plan.
+#[test]
+fn dense_b4_cubes_are_refused_up_front_naming_the_parameters() {
+    let e = scaffold_schedule(&ShapeSpec::Cube { h: 2, e: 4 }, 4).unwrap_err();
+    assert!(
+        e.message.contains("b ≥ 5") && e.message.contains("b = 4") && e.message.contains("e = 4"),
+        "{}",
+        e.message
+    );
+    let e = scaffold_schedule(&ShapeSpec::Cube { h: 3, e: 2 }, 4).unwrap_err();
+    assert!(
+        e.message.contains("h = 3") && e.message.contains("e = 2"),
+        "{}",
+        e.message
+    );
+    assert!(e.module.is_none(), "refused before planning: {e:?}");
+    for (e, b) in [(3, 4), (5, 5)] {
+        let s = scaffold_schedule(&ShapeSpec::Cube { h: 2, e }, b).unwrap();
+        assert!(s.move_count() > 0);
+    }
+}

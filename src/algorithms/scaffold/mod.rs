@@ -68,6 +68,20 @@ pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError>
                     "a cube needs h ≥ 1 and 1 ≤ e ≤ b (got h = {h}, e = {e}, b = {b})"
                 )));
             }
+            // Seed 000 §3.2.2 puts the lower bound at b = 4 for tiles to
+            // let modules through. For cubes at b = 4 the planner finds no
+            // route to the tip of an upward branch once a tile stands on a
+            // full-length branch: measured failing for h = 2 with e = b and
+            // for h = 3 with every e = 1…4; h = 2 with e ≤ 3 plans and
+            // certifies. Refused up front (naming the parameters) rather
+            // than failing mid-plan on one module.
+            if b == 4 && (*h >= 3 || *e == b) {
+                return Err(InputError::new(format!(
+                    "a cube with b = 4 plans only for h ≤ 2 and e < b (got h = {h}, e = {e}, \
+                     b = {b}): the 4-tiles are too dense for modules to reach the tips of \
+                     upward branches; use b ≥ 5, or e ≤ 3 with h = 2"
+                )));
+            }
             let l = (*h as i32 - 1) * bi + *e as i32;
             Scaffold::build(
                 &CubeShape { l },

@@ -269,6 +269,19 @@ impl<'a> Planner<'a> {
         true
     }
 
+    /// Whether `m`'s blocking cells are crossed by no other rotation of
+    /// `step`: two movers of one step may each be legal against the
+    /// structure and the agents' cells, yet sweep through the same empty
+    /// cell at the same time (the collision of pyramid h = 2, b = 8).
+    fn sweep_is_free(&self, m: &Motion, step: usize) -> bool {
+        step >= self.swept.len()
+            || self
+                .rules
+                .blocking_cells(m)
+                .into_iter()
+                .all(|b| !self.swept[step].contains(&b))
+    }
+
     fn free_of_agents(&self, c: Cell, t: usize) -> bool {
         t >= self.positions.len() || !self.positions[t].contains_key(&c)
     }
@@ -316,7 +329,7 @@ impl<'a> Planner<'a> {
                             || !self.free_of_agents(q, t)
                             || !self.free_of_agents(q, step)
                     };
-                    ok = self.rules.allows(&m, &occ);
+                    ok = self.rules.allows(&m, &occ) && self.sweep_is_free(&m, step);
                 }
                 if ok && last {
                     // Once in place, the module must not stand in the way
