@@ -93,10 +93,7 @@ fn certification(c: &mut Criterion) {
     g.bench_function(
         format!("random walk, {moves} moves, lattice checks only"),
         |b| {
-            let opts = Options {
-                lattice_only: true,
-                ..Options::default()
-            };
+            let opts = Options::lattice_only();
             b.iter(|| black_box(certify(&s, &opts).unwrap().certified))
         },
     );

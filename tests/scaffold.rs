@@ -98,14 +98,7 @@ fn survey() {
         let t = std::time::Instant::now();
         match scaffold_schedule(&shape(&name), 6) {
             Ok(s) => {
-                let r = certify(
-                    &s,
-                    &Options {
-                        lattice_only: true,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
+                let r = certify(&s, &Options::lattice_only()).unwrap();
                 eprintln!(
                     "{name}: {} modules, {} steps, {} moves, gen {:?}, certified {}",
                     s.meta["scaffold_modules"],

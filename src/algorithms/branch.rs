@@ -117,14 +117,7 @@ mod tests {
     #[test]
     fn a_grown_branch_is_lattice_valid_and_ends_straight() {
         let s = branch_schedule(5, 3.6).unwrap();
-        let r = certify(
-            &s,
-            &Options {
-                lattice_only: true,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let r = certify(&s, &Options::lattice_only()).unwrap();
         assert!(r.certified, "{}", r.summary());
         // 5 entries, then 1 + 2 + … + 5 rolls.
         assert_eq!(s.steps.len(), 5 + 15);

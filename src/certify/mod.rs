@@ -42,6 +42,17 @@ pub struct Options {
     pub base_dir: Option<PathBuf>,
 }
 
+impl Options {
+    /// Default options with the lattice checks only (no geometry, no
+    /// mechanics): what generators' own tests and the lattice studies use.
+    pub fn lattice_only() -> Options {
+        Options {
+            lattice_only: true,
+            ..Default::default()
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {

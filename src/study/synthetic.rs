@@ -127,25 +127,11 @@ mod tests {
     #[test]
     fn the_synthetic_block_schedule_is_lattice_valid() {
         let s = block_with_walkers(5, 2, 4, 10, 1);
-        let r = certify(
-            &s,
-            &Options {
-                lattice_only: true,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let r = certify(&s, &Options::lattice_only()).unwrap();
         assert!(r.certified, "{}", r.summary());
         assert!(s.move_count() > 0);
         let s = islands_with_walkers(3, 3, 2, 6, 10, 2);
-        let r = certify(
-            &s,
-            &Options {
-                lattice_only: true,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let r = certify(&s, &Options::lattice_only()).unwrap();
         assert!(r.certified, "{}", r.summary());
     }
 }

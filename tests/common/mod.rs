@@ -46,10 +46,7 @@ pub fn rot(module: u32, pivot: u32, from: Cell, to: Cell) -> Event {
 
 /// Certifies with the lattice checks only (these tests are about them).
 pub fn lattice_report(s: &Schedule) -> Report {
-    let opts = Options {
-        lattice_only: true,
-        ..Default::default()
-    };
+    let opts = Options::lattice_only();
     certify::certify(s, &opts).expect("usable input")
 }
 
