@@ -236,13 +236,13 @@ struct Reference {
 /// (the steps of a schedule).
 ///
 /// From scratch, every solve factors the step's stiffness matrix (sparse
-/// Cholesky). Incrementally, the factor of an earlier step is kept and
-/// preconditions CG on the current matrix, started from the previous
-/// displacements of the same bodies: consecutive steps differ by the few
-/// modules that start or stop moving, so the preconditioned matrix is the
-/// identity plus a low-rank change and CG converges in a few iterations.
-/// The factor is refreshed when that stops being true (CG needs more than
-/// [`Settings::reuse_iterations`]).
+/// Cholesky). Incrementally, each component keeps the factor of the last
+/// step that factored it, and CG preconditioned by it, started from the
+/// previous displacements of the same bodies, solves the current step —
+/// exactly in one iteration when only the loads changed. It is tried only
+/// while at most [`Settings::reuse_max_changed`] bodies changed, for at
+/// most [`Settings::reuse_iterations`] iterations; otherwise the component
+/// is factored afresh and that factor is kept.
 pub struct Analyzer {
     pub model: Model,
     pub settings: Settings,

@@ -72,11 +72,6 @@ impl<'a> KeptFactor<'a> {
         }
     }
 
-    /// Bodies not in the kept factor.
-    pub fn new_bodies(&self) -> usize {
-        self.new.len()
-    }
-
     fn solve_nn(knn: &Result<Factor, Vec<Block>>, x: &mut [Vec6]) {
         match knn {
             Ok(f) => f.solve_in_place(x),
