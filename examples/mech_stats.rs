@@ -1,6 +1,7 @@
 //! Probe: per-step statistics of a scenario's mechanical replay (bodies,
 //! links, movers, bodies added/removed, factorisations, CG iterations).
 //! `cargo run --release --example mech_stats -- SCENARIO [INCREMENTAL(1|0)] [STEPS]`
+//! prints every 50th step, or every step with `ALL=1` in the environment.
 use reconfcheck::certify::load_check::replay;
 use reconfcheck::mechanics::Model;
 use reconfcheck::scenario::Scenario;
@@ -38,7 +39,7 @@ fn main() {
         let added = cur.difference(&prev).count();
         let removed = prev.difference(&cur).count();
         tot_its += a.iterations;
-        if k % 50 == 0 || k < 5 {
+        if std::env::var("ALL").is_ok() || k % 50 == 0 || k < 5 {
             println!(
                 "step {k}: free {} links {} hanging {} +{added} -{removed} factorisations {} its {} max_u {:.3} dt {:.3}s",
                 cur.len(),

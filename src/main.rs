@@ -104,6 +104,10 @@ enum Command {
         /// default 2).
         #[arg(long)]
         size: Option<u32>,
+        /// The CSG shape file of `--family csg` (e.g.
+        /// models/shapes/sandcastle.csg).
+        #[arg(long, value_name = "FILE")]
+        shape: Option<PathBuf>,
         /// Smallest branch length (default: the family's, 1 or 4).
         #[arg(long)]
         b_min: Option<usize>,
@@ -318,6 +322,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             family,
             model,
             size,
+            shape,
             b_min,
             b_max,
             pressure,
@@ -338,9 +343,10 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             if b_min == 0 || b_min > b_max {
                 return Err(InputError::new(format!("bad range of b: {b_min}..={b_max}")).into());
             }
-            let generate = b_study::family(&family, m.spacing * 1e3, size)?;
+            let generate = b_study::family(&family, m.spacing * 1e3, size, shape.as_deref())?;
             let lengths: Vec<usize> = (b_min..=b_max).collect();
-            let st = b_study::b_study(&family, &m, &lengths, generate)?;
+            let progress = std::io::stderr().is_terminal();
+            let st = b_study::b_study(&family, &m, &lengths, generate, progress)?;
             print!("{}", st.table());
             if let Some(p) = &plot {
                 st.plot(p).map_err(Failure::Output)?;
@@ -421,6 +427,7 @@ fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<
         lattice_only: args.lattice_only,
         model: args.model.clone(),
         base_dir: origin.parent().map(Path::to_path_buf),
+        range_steps: None,
     };
     let report: Report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
     let json = report.to_json();

@@ -373,6 +373,43 @@ fn b_study_refuses_an_unknown_family_and_a_too_short_scaffold_branch() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("b ≥ 4"), "{}", stderr(&o));
+    // The CSG family needs its shape file, and the file must exist.
+    let o = bin().args(["b-study", "--family", "csg"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--family csg"), "{}", stderr(&o));
+    let o = bin()
+        .args(["b-study", "--family", "csg", "--shape", "no-such-shape.csg"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no-such-shape.csg"), "{}", stderr(&o));
+}
+
+#[test]
+fn b_study_of_a_csg_shape_checks_its_scaffold_for_each_b() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let json = scratch("b-half-sphere.json");
+    let o = bin()
+        .args(["b-study", "--family", "csg", "--b-min", "5", "--b-max", "6"])
+        .arg("--shape")
+        .arg(root.join("models/shapes/half-sphere-d3.csg"))
+        .arg("--model")
+        .arg(root.join("models/catom-3.6mm.toml"))
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let st: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let rows = st["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        assert_eq!(r["lattice_violations"], 0, "{r}");
+        // The half-sphere of side 3 holds b = 5 and 6 (0.52, 0.58).
+        let u = r["max_utilisation"].as_f64().unwrap();
+        assert!(u > 0.3 && u < 0.8, "{r}");
+    }
+    assert_eq!(st["b_max"], 6);
 }
 
 #[test]

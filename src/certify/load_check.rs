@@ -22,13 +22,19 @@ pub const NAME: &str = "mechanics";
 /// The mechanical check of every step.
 pub struct LoadCheck {
     analyzer: Mutex<Analyzer>,
+    /// The model at the schedule's spacing, and whether to reuse work.
+    model: Model,
+    incremental: bool,
 }
 
 impl LoadCheck {
     /// A check with `model` at the schedule's lattice spacing `spacing` (m).
     pub fn new(model: &Model, spacing: f64, incremental: bool) -> LoadCheck {
+        let model = model.at_spacing(spacing);
         LoadCheck {
-            analyzer: Mutex::new(Analyzer::new(model.at_spacing(spacing), incremental)),
+            analyzer: Mutex::new(Analyzer::new(model.clone(), incremental)),
+            model,
+            incremental,
         }
     }
 
@@ -177,6 +183,17 @@ impl StepCheck for LoadCheck {
         let (s, a) = self.analyse(world, &FxHashSet::default(), &[]);
         report(step, &s, &a, out);
     }
+
+    /// Every step's analysis dominates certification of a large schedule,
+    /// so ranges of steps run in parallel, each with its own analyser: the
+    /// reuse between steps is lost only at a range's first step.
+    fn for_range(&self) -> Option<Box<dyn StepCheck>> {
+        Some(Box::new(LoadCheck {
+            analyzer: Mutex::new(Analyzer::new(self.model.clone(), self.incremental)),
+            model: self.model.clone(),
+            incremental: self.incremental,
+        }))
+    }
 }
 
 /// Replays `schedule` and analyses every intermediate structure (and the
@@ -306,6 +323,36 @@ mod tests {
             v[0].message
         );
         assert!(v[0].detail["utilisation"].as_f64().unwrap() > 1.0);
+    }
+
+    #[test]
+    fn ranges_of_steps_checked_in_parallel_give_the_results_of_one_pass() {
+        use crate::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
+        use crate::certify::{LatticeCheck, certify_with};
+        // The 2-pyramid at b = 9 is overloaded from its step 84 on.
+        let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 2 }, 9).unwrap();
+        let model = Model::load(&models().join("catom-3.6mm.toml")).unwrap();
+        let run = |range_steps| {
+            let load = LoadCheck::new(&model, s.spacing.metres(), true);
+            let o = Options {
+                range_steps: Some(range_steps),
+                ..Default::default()
+            };
+            certify_with(&s, &o, &[&LatticeCheck, &load]).unwrap()
+        };
+        let (one, ranged) = (run(0), run(7));
+        assert!(!one.certified);
+        assert_eq!(one.per_step.len(), ranged.per_step.len());
+        for (a, b) in one.per_step.iter().zip(&ranged.per_step) {
+            let (ua, ub) = (a.metrics["max_utilisation"], b.metrics["max_utilisation"]);
+            assert!((ua - ub).abs() <= 1e-6 * ua.max(1e-9), "step {}: {ua} vs {ub}", a.step);
+            assert_eq!(a.violations, b.violations, "step {}", a.step);
+        }
+        let key = |r: &crate::certify::Report| -> Vec<(usize, ViolationKind)> {
+            r.violations.iter().map(|v| (v.step, v.kind)).collect()
+        };
+        assert_eq!(key(&one), key(&ranged));
+        assert!(key(&one).iter().any(|&(_, k)| k == ViolationKind::Overload));
     }
 
     #[test]

@@ -40,6 +40,10 @@ pub struct Options {
     /// Directory the schedule's relative `model` path is resolved against
     /// (the schedule file's directory).
     pub base_dir: Option<PathBuf>,
+    /// Steps per range for the checks that run over ranges of steps in
+    /// parallel (see [`StepCheck::for_range`]): `None` chooses from the
+    /// number of threads, `Some(0)` runs every check in one pass.
+    pub range_steps: Option<usize>,
 }
 
 impl Options {
@@ -63,6 +67,7 @@ impl Default for Options {
             lattice_only: false,
             model: None,
             base_dir: None,
+            range_steps: None,
         }
     }
 }
@@ -90,6 +95,31 @@ pub trait StepCheck: Send + Sync {
     /// Examines the final configuration (after the last step).
     fn check_final(&self, world: &World, step: usize, out: &mut StepOutcome) {
         let _ = (world, step, out);
+    }
+    /// A fresh instance of this check for one range of consecutive steps,
+    /// for checks that are costly per step and carry state from step to
+    /// step (the mechanics' kept factors): the ranges then run in
+    /// parallel, each from the scene at its first step. `None` (the
+    /// default): the check runs in the one pass over the schedule.
+    fn for_range(&self) -> Option<Box<dyn StepCheck>> {
+        None
+    }
+}
+
+/// Steps per range for `steps` steps: about four ranges per thread (the
+/// later steps of a growing structure cost more, and rayon balances the
+/// ranges), none below 16 steps or on one thread.
+fn range_steps(opts: &Options, steps: usize) -> usize {
+    match opts.range_steps {
+        Some(n) => n,
+        None => {
+            let threads = rayon::current_num_threads();
+            if threads < 2 || steps < 64 {
+                0
+            } else {
+                steps.div_ceil(4 * threads).max(16)
+            }
+        }
     }
 }
 
@@ -156,6 +186,13 @@ pub fn certify_with(
     checks: &[&dyn StepCheck],
 ) -> Result<Report, InputError> {
     let mut world = World::initial(schedule)?;
+    let range = range_steps(opts, schedule.steps.len());
+    let (ranged, inline): (Vec<&dyn StepCheck>, Vec<&dyn StepCheck>) = checks
+        .iter()
+        .copied()
+        .partition(|c| range > 0 && c.for_range().is_some());
+    // The scene at the first step of every range, taken in the one pass.
+    let mut starts: Vec<(usize, World)> = Vec::new();
     let mut report = Report {
         format: report::REPORT_FORMAT.to_string(),
         version: 1,
@@ -171,7 +208,8 @@ pub fn certify_with(
         warnings: Vec::new(),
         per_step: Vec::with_capacity(schedule.steps.len()),
     };
-    let bar = progress_bar(opts, schedule.steps.len());
+    let passes = if ranged.is_empty() { 1 } else { 2 };
+    let bar = progress_bar(opts, passes * schedule.steps.len());
 
     // The initial configuration must stand on its own.
     let nobody = Default::default();
@@ -193,6 +231,9 @@ pub fn certify_with(
 
     for (k, step) in schedule.steps.iter().enumerate() {
         let index = k + 1;
+        if !ranged.is_empty() && k % range == 0 {
+            starts.push((k, world.clone()));
+        }
         let plan = world.resolve(index, step)?;
         let mut out = StepOutcome {
             violations: plan.violations.clone(),
@@ -202,7 +243,7 @@ pub fn certify_with(
             world: &world,
             plan: &plan,
         };
-        for c in checks {
+        for c in &inline {
             c.check(&ctx, &mut out);
         }
         let clashes = world.apply(&plan);
@@ -229,6 +270,21 @@ pub fn certify_with(
             break;
         }
     }
+    if !ranged.is_empty() {
+        let last = report.per_step.len();
+        let outcomes = ranges_in_parallel(schedule, &ranged, &starts, range, last, &bar)?;
+        for (k, out) in outcomes {
+            let r = &mut report.per_step[k];
+            r.violations += out.violations.len();
+            r.warnings += out.warnings.len();
+            r.metrics.extend(out.metrics);
+            report.violations.extend(out.violations);
+            report.warnings.extend(out.warnings);
+        }
+        // Back in step order, each step's own findings in check order.
+        report.violations.sort_by_key(|v| v.step);
+        report.warnings.sort_by_key(|v| v.step);
+    }
     bar.finish_and_clear();
 
     if report.stopped_at.is_none() {
@@ -250,6 +306,8 @@ pub fn certify_with(
         }
         let mut out = StepOutcome::default();
         for c in checks {
+            // A ranged check's own instance saw no step: it analyses the
+            // final scene from scratch.
             c.check_final(&world, final_step, &mut out);
         }
         report.violations.extend(out.violations);
@@ -257,6 +315,46 @@ pub fn certify_with(
     }
     report.certified = report.violations.is_empty() && report.stopped_at.is_none();
     Ok(report)
+}
+
+/// Runs the `ranged` checks over the first `last` steps, one range of
+/// `range` steps per scene in `starts`, in parallel; returns every step's
+/// findings (0-based step index), in step order.
+fn ranges_in_parallel(
+    schedule: &Schedule,
+    ranged: &[&dyn StepCheck],
+    starts: &[(usize, World)],
+    range: usize,
+    last: usize,
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<(usize, StepOutcome)>, InputError> {
+    use rayon::prelude::*;
+    let per_range: Vec<Vec<(usize, StepOutcome)>> = starts
+        .par_iter()
+        .filter(|(first, _)| *first < last)
+        .map(|(first, start)| {
+            let checks: Vec<Box<dyn StepCheck>> =
+                ranged.iter().filter_map(|c| c.for_range()).collect();
+            let mut world = start.clone();
+            let mut found = Vec::new();
+            for k in *first..(first + range).min(last) {
+                let plan = world.resolve(k + 1, &schedule.steps[k])?;
+                let mut out = StepOutcome::default();
+                let ctx = StepContext {
+                    world: &world,
+                    plan: &plan,
+                };
+                for c in &checks {
+                    c.check(&ctx, &mut out);
+                }
+                world.apply(&plan);
+                found.push((k, out));
+                bar.inc(1);
+            }
+            Ok(found)
+        })
+        .collect::<Result<_, InputError>>()?;
+    Ok(per_range.into_iter().flatten().collect())
 }
 
 fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {

@@ -544,6 +544,24 @@ impl Analyzer {
         out
     }
 
+    /// The stiffness matrix of every free body of `s` (in body order, fixed
+    /// bodies left out), every link held and none sliding — the system a
+    /// from-scratch step factors, for measurements such as
+    /// `examples/mech_floor.rs`.
+    pub fn stiffness_matrix(&mut self, s: &Structure) -> BlockMatrix {
+        let mut local = vec![u32::MAX; s.bodies.len()];
+        let mut n = 0;
+        for (i, b) in s.bodies.iter().enumerate() {
+            if !b.fixed {
+                local[i] = n;
+                n += 1;
+            }
+        }
+        let links: Vec<usize> = (0..s.links.len()).collect();
+        let no = vec![false; s.links.len()];
+        self.assemble(s, &links, &local, &no, &no, n as usize)
+    }
+
     fn link_springs(&self, l: &Link, sliding: bool) -> Springs {
         let mut k = if l.is_ground() {
             self.ground_springs

@@ -316,6 +316,21 @@ fn a_floating_part_has_no_equilibrium() {
 }
 
 #[test]
+fn the_stiffness_matrix_of_a_step_leaves_out_fixed_modules_and_is_definite_when_anchored() {
+    use super::direct::Factor;
+    let cells: Vec<Cell> = (0..=4).map(|i| Cell::new(i, 0, 0)).collect();
+    let anchored = structure(&FccLattice, None, &cells, &[0], &[]);
+    let mut a = tight(Model::default_catom());
+    let k = a.stiffness_matrix(&anchored);
+    assert_eq!(k.len(), 4, "the fixed root has no unknowns");
+    assert_eq!(k.off.len(), 3, "a chain: one block per free–free connector");
+    assert!(Factor::new(&k).is_some());
+    // Nothing fixed and no ground: the chain floats, K is singular.
+    let floating = structure(&FccLattice, None, &cells, &[], &[]);
+    assert!(Factor::new(&a.stiffness_matrix(&floating)).is_none());
+}
+
+#[test]
 fn a_long_cantilever_is_overloaded_at_its_root() {
     let model = Model::default_catom().with_connector(10e3, Bending::RigidHinge);
     let cells: Vec<Cell> = (0..=4).map(|i| Cell::new(i, 0, 0)).collect();

@@ -19,6 +19,7 @@ use crate::mechanics::closed_form;
 use crate::mechanics::model::{Bending, Model};
 use crate::schedule::Schedule;
 use serde::Serialize;
+use std::path::Path;
 
 /// Results for one branch length.
 #[derive(Clone, Debug, Serialize)]
@@ -97,10 +98,24 @@ pub type FamilyFn = Box<dyn Fn(usize) -> Result<Schedule, InputError>>;
 ///   with it the planner finds no route for one module of the 2-tile cube
 ///   at `b = 4`; `e = b − 1` plans for every `b` from 4 to 10.
 ///
-/// `size` is ignored by `branch`. Scaffold families need `b ≥ 4`
+/// * `csg` — seed 000's scaffold of the shape in the CSG file `csg`
+///   (e.g. `models/shapes/sandcastle.csg`): the b-study of one's own shape.
+///   The shape is fixed in cells, so each `b` tiles the same volume.
+///
+/// `size` is ignored by `branch` and `csg`. Scaffold families need `b ≥ 4`
 /// (seed 000 §3.2.2); the generator says so for smaller `b`.
-pub fn family(name: &str, spacing_mm: f64, size: Option<u32>) -> Result<FamilyFn, InputError> {
+pub fn family(
+    name: &str,
+    spacing_mm: f64,
+    size: Option<u32>,
+    csg: Option<&Path>,
+) -> Result<FamilyFn, InputError> {
     use crate::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
+    if csg.is_some() != (name == "csg") {
+        return Err(InputError::new(
+            "b-study: a CSG shape file goes with --family csg, and only with it",
+        ));
+    }
     let h = size.unwrap_or(2);
     if h == 0 {
         return Err(InputError::new(
@@ -125,6 +140,15 @@ pub fn family(name: &str, spacing_mm: f64, size: Option<u32>) -> Result<FamilyFn
                 .max(1);
             scaffold(ShapeSpec::Cube { h, e }, b)
         })),
+        "csg" => {
+            let path = csg.expect("checked above").to_path_buf();
+            if !path.is_file() {
+                return Err(InputError::new("no such CSG shape file").in_file(&path));
+            }
+            Ok(Box::new(move |b| {
+                scaffold(ShapeSpec::Csg { path: path.clone() }, b)
+            }))
+        }
         other => Err(InputError::new(format!(
             "unknown b-study family '{other}' (known: {})",
             FAMILIES.join(", ")
@@ -133,7 +157,7 @@ pub fn family(name: &str, spacing_mm: f64, size: Option<u32>) -> Result<FamilyFn
 }
 
 /// Names accepted by [`family`].
-pub const FAMILIES: &[&str] = &["branch", "pyramid", "cube"];
+pub const FAMILIES: &[&str] = &["branch", "pyramid", "cube", "csg"];
 
 /// The range of `b` a family is studied over by default: the branch from
 /// 1, seed 000's scaffolds from their smallest branch length, 4.
@@ -144,6 +168,20 @@ pub fn default_range(name: &str) -> (usize, usize) {
     }
 }
 
+fn progress_bar(on: bool, b: usize, steps: usize) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    if !on {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})")
+            .expect("valid template"),
+    );
+    bar.set_message(b.to_string());
+    bar
+}
+
 /// Pressures of the sweep (kPa): 1…150, SPEC §7.
 pub fn sweep_pressures() -> Vec<f64> {
     let mut v: Vec<f64> = (1..=20).map(f64::from).collect();
@@ -151,16 +189,20 @@ pub fn sweep_pressures() -> Vec<f64> {
     v
 }
 
-/// Runs the study for `lengths` with `generate(b)` producing the schedule.
+/// Runs the study for `lengths` with `generate(b)` producing the schedule;
+/// `progress` draws a bar over each schedule's steps on stderr (a scaffold
+/// of the sandcastle's size takes minutes per `b`).
 pub fn b_study(
     family: &str,
     model: &Model,
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
+    progress: bool,
 ) -> Result<Study, InputError> {
     let mut rows = Vec::new();
     for &b in lengths {
         let schedule = generate(b)?;
+        let bar = progress_bar(progress, b, schedule.steps.len() + 1);
         let m = model.at_spacing(schedule.spacing.metres());
         let mut row = Row {
             b,
@@ -193,6 +235,7 @@ pub fn b_study(
             ..m.connector
         };
         replay(&schedule, &m, true, |step, s, a, out| {
+            bar.inc(1);
             row.lattice_violations += out
                 .violations
                 .iter()
@@ -229,6 +272,7 @@ pub fn b_study(
                     .max(required_pressure(&load, &elastic));
             }
         })?;
+        bar.finish_and_clear();
         if row.no_equilibrium {
             row.min_pressure_rigid_hinge = f64::INFINITY;
             row.min_pressure_elastic = f64::INFINITY;
@@ -530,7 +574,14 @@ mod tests {
     fn the_branch_study_agrees_with_the_closed_form_cantilever_bound() {
         let model = Model::default_catom();
         let lengths: Vec<usize> = (1..=7).collect();
-        let st = b_study("branch", &model, &lengths, |b| branch_schedule(b, 3.6)).unwrap();
+        let st = b_study(
+            "branch",
+            &model,
+            &lengths,
+            |b| branch_schedule(b, 3.6),
+            false,
+        )
+        .unwrap();
         for r in &st.rows {
             assert_eq!(r.lattice_violations, 0);
             // The worst step of growing a branch of b is the last agent
@@ -566,8 +617,8 @@ mod tests {
     #[test]
     fn the_pyramid_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
         let model = Model::default_catom();
-        let generate = family("pyramid", 3.6, None).unwrap();
-        let st = b_study("pyramid", &model, &[4, 5, 6], generate).unwrap();
+        let generate = family("pyramid", 3.6, None, None).unwrap();
+        let st = b_study("pyramid", &model, &[4, 5, 6], generate, false).unwrap();
         assert_eq!(st.rows.len(), 3);
         for r in &st.rows {
             assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
@@ -599,11 +650,49 @@ mod tests {
         assert_eq!(st.b_max, 6);
     }
 
+    /// The layer `z` of the critical connector's upper cell.
+    fn critical_layer(r: &Row) -> i32 {
+        let c = &r.critical_connector;
+        let last = &c[c.rfind('(').expect("cells") + 1..];
+        let last = &last[..last.find(')').expect("cells")];
+        last.rsplit(", ").next().unwrap().parse().unwrap()
+    }
+
+    #[test]
+    fn a_cube_of_three_tiles_is_limited_by_its_upper_tiles_not_its_ground_branches() {
+        // At b = 7 the 2-tile cube holds (its worst connectors lie in the
+        // ground-tile layer and its tilted branches); with a second tile
+        // layer the connectors of the upper tiles are overloaded: the
+        // shape's size lowers b_max (8 → 6, docs/mechanics.md).
+        let model = Model::default_catom();
+        let two = b_study(
+            "cube",
+            &model,
+            &[7],
+            family("cube", 3.6, Some(2), None).unwrap(),
+            false,
+        )
+        .unwrap();
+        let three = b_study(
+            "cube",
+            &model,
+            &[7],
+            family("cube", 3.6, Some(3), None).unwrap(),
+            false,
+        )
+        .unwrap();
+        let (two, three) = (&two.rows[0], &three.rows[0]);
+        assert!(two.max_utilisation < 1.0, "{two:?}");
+        assert!(three.max_utilisation > 1.3, "{three:?}");
+        assert_eq!(three.lattice_violations, 0);
+        assert!(critical_layer(three) > 2, "{}", three.critical_connector);
+    }
+
     #[test]
     fn the_cube_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
         let model = Model::default_catom();
-        let generate = family("cube", 3.6, None).unwrap();
-        let st = b_study("cube", &model, &[4, 5], generate).unwrap();
+        let generate = family("cube", 3.6, None, None).unwrap();
+        let st = b_study("cube", &model, &[4, 5], generate, false).unwrap();
         for r in &st.rows {
             assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
             assert!(!r.no_equilibrium, "b = {}", r.b);
@@ -612,7 +701,7 @@ mod tests {
         // A cube of 2 tiles a side holds more modules than the 2-pyramid of
         // equal b, and more as b grows.
         let modules = |f: &str, b: usize| {
-            family(f, 3.6, None).unwrap()(b).unwrap().meta["scaffold_modules"]
+            family(f, 3.6, None, None).unwrap()(b).unwrap().meta["scaffold_modules"]
                 .as_u64()
                 .unwrap()
         };
@@ -622,23 +711,30 @@ mod tests {
 
     #[test]
     fn scaffold_families_take_the_size_and_refuse_bad_input() {
-        let small = family("pyramid", 3.6, Some(1)).unwrap()(4).unwrap();
-        let large = family("pyramid", 3.6, Some(2)).unwrap()(4).unwrap();
+        let small = family("pyramid", 3.6, Some(1), None).unwrap()(4).unwrap();
+        let large = family("pyramid", 3.6, Some(2), None).unwrap()(4).unwrap();
         assert!(small.steps.len() < large.steps.len());
         // The model's spacing is carried into the schedule.
-        let s = family("pyramid", 2.0, Some(1)).unwrap()(4).unwrap();
+        let s = family("pyramid", 2.0, Some(1), None).unwrap()(4).unwrap();
         assert!((s.spacing.metres() - 2e-3).abs() < 1e-12);
         // Seed 000 needs b ≥ 4; size 0 and unknown families are refused.
-        assert!(family("pyramid", 3.6, None).unwrap()(3).is_err());
-        assert!(family("cube", 3.6, Some(0)).is_err());
-        let e = family("torus", 3.6, None).err().unwrap();
+        assert!(family("pyramid", 3.6, None, None).unwrap()(3).is_err());
+        assert!(family("cube", 3.6, Some(0), None).is_err());
+        let e = family("torus", 3.6, None, None).err().unwrap();
         assert!(e.to_string().contains("pyramid"), "{e}");
     }
 
     #[test]
     fn the_plot_is_written_as_png() {
         let model = Model::default_catom();
-        let st = b_study("branch", &model, &[1, 2, 3], |b| branch_schedule(b, 3.6)).unwrap();
+        let st = b_study(
+            "branch",
+            &model,
+            &[1, 2, 3],
+            |b| branch_schedule(b, 3.6),
+            false,
+        )
+        .unwrap();
         let dir = std::env::temp_dir().join(format!("reconfcheck-bstudy-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("b.png");
