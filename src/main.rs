@@ -13,6 +13,14 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// mimalloc rather than the system allocator: a certification allocates
+/// per-step arrays that grow with the structure between long-lived small
+/// allocations (the report), and glibc's heap kept every outgrown block —
+/// one pass over the sandcastle reached 24 GB (cube-d5: 2.3 GB against
+/// 0.12 GB with large blocks mapped apart).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const EXIT_VIOLATIONS: u8 = 1;
 const EXIT_INPUT: u8 = 2;
 const EXIT_OUTPUT: u8 = 3;

@@ -345,7 +345,11 @@ mod tests {
         assert_eq!(one.per_step.len(), ranged.per_step.len());
         for (a, b) in one.per_step.iter().zip(&ranged.per_step) {
             let (ua, ub) = (a.metrics["max_utilisation"], b.metrics["max_utilisation"]);
-            assert!((ua - ub).abs() <= 1e-6 * ua.max(1e-9), "step {}: {ua} vs {ub}", a.step);
+            assert!(
+                (ua - ub).abs() <= 1e-6 * ua.max(1e-9),
+                "step {}: {ua} vs {ub}",
+                a.step
+            );
             assert_eq!(a.violations, b.violations, "step {}", a.step);
         }
         let key = |r: &crate::certify::Report| -> Vec<(usize, ViolationKind)> {
