@@ -30,7 +30,12 @@ pub struct LoadCheck {
 impl LoadCheck {
     /// A check with `model` at the schedule's lattice spacing `spacing` (m).
     pub fn new(model: &Model, spacing: f64, incremental: bool) -> LoadCheck {
-        let model = model.at_spacing(spacing);
+        LoadCheck::at_spacing(model.at_spacing(spacing), incremental)
+    }
+
+    /// A check with `model` already at the schedule's spacing, and a fresh
+    /// analyser.
+    fn at_spacing(model: Model, incremental: bool) -> LoadCheck {
         LoadCheck {
             analyzer: Mutex::new(Analyzer::new(model.clone(), incremental)),
             model,
@@ -188,11 +193,10 @@ impl StepCheck for LoadCheck {
     /// so ranges of steps run in parallel, each with its own analyser: the
     /// reuse between steps is lost only at a range's first step.
     fn for_range(&self) -> Option<Box<dyn StepCheck>> {
-        Some(Box::new(LoadCheck {
-            analyzer: Mutex::new(Analyzer::new(self.model.clone(), self.incremental)),
-            model: self.model.clone(),
-            incremental: self.incremental,
-        }))
+        Some(Box::new(LoadCheck::at_spacing(
+            self.model.clone(),
+            self.incremental,
+        )))
     }
 }
 

@@ -169,15 +169,10 @@ pub fn default_range(name: &str) -> (usize, usize) {
 }
 
 fn progress_bar(on: bool, b: usize, steps: usize) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
     if !on {
-        return ProgressBar::hidden();
+        return indicatif::ProgressBar::hidden();
     }
-    let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})")
-            .expect("valid template"),
-    );
+    let bar = crate::certify::step_bar(steps, "b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})");
     bar.set_message(b.to_string());
     bar
 }
