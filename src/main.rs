@@ -167,6 +167,11 @@ enum Command {
         /// draw the mean SAS median as a dashed line.
         #[arg(long)]
         repeats: Option<usize>,
+        /// How the random configurations grow: `member` is §V-B as written;
+        /// `chain` (grow from the module added last) measures how much the
+        /// curve owes to the generator.
+        #[arg(long, value_enum, default_value = "member")]
+        growth: GrowthArg,
         /// Box plot (PNG, or SVG by extension).
         #[arg(short, long)]
         output: PathBuf,
@@ -186,6 +191,16 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+/// The CLI's names for
+/// [`reconfcheck::algorithms::active_subtraction::random::Growth`].
+#[derive(Copy, Clone, Debug, clap::ValueEnum)]
+enum GrowthArg {
+    /// A random included module gains a random free neighbour (§V-B).
+    Member,
+    /// The module added last gains one, while it can.
+    Chain,
 }
 
 /// The pictures `render` draws (the CLI's names for
@@ -294,14 +309,19 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             samples,
             seed,
             repeats,
+            growth,
             output,
         } => {
-            use reconfcheck::algorithms::active_subtraction::study;
+            use reconfcheck::algorithms::active_subtraction::{random::Growth, study};
             let cfg = study::StudyConfig {
                 sizes,
                 densities,
                 samples,
                 seed,
+                growth: match growth {
+                    GrowthArg::Member => Growth::Member,
+                    GrowthArg::Chain => Growth::Chain,
+                },
             };
             let bad = |m: String| Failure::Input(InputError::new(m));
             if cfg.samples == 0

@@ -1,7 +1,7 @@
 //! Seed 003 (active subtraction) end to end: the paper's figures, the
 //! guarantees of SAS and PAS, certification of every generated schedule.
 
-use reconfcheck::algorithms::active_subtraction::random::random_shape;
+use reconfcheck::algorithms::active_subtraction::random::{Growth, random_shape};
 use reconfcheck::algorithms::active_subtraction::{Mode, Plan, Shape, study};
 use reconfcheck::algorithms::{self};
 use reconfcheck::certify::{Options, ViolationKind, certify};
@@ -374,6 +374,7 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
         densities: vec![10, 40, 70],
         samples: 6,
         seed: 0,
+        growth: Growth::Member,
     };
     let samples = study::run(&cfg).unwrap();
     assert_eq!(samples.len(), 2 * 3 * 6);
@@ -427,6 +428,7 @@ fn density_study_sas_and_best_case_rise_with_density() {
         // (`density-study --repeats`: sd 0.3–0.5 at 80 samples).
         samples: 80,
         seed: 0,
+        growth: Growth::Member,
     };
     let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
     let sas: Vec<f64> = rows.iter().map(|r| r.sas.median).collect();
@@ -447,12 +449,13 @@ fn density_study_sas_and_best_case_rise_with_density() {
 fn density_study_spread_summarises_the_medians_of_repeated_studies() {
     let cfg = study::StudyConfig {
         sizes: vec![10],
-        densities: vec![10, 50],
+        densities: vec![10, 40, 70],
         samples: 5,
         seed: 7,
+        growth: Growth::Member,
     };
     let spread = study::spread(&cfg, 3).unwrap();
-    assert_eq!(spread.len(), 2);
+    assert_eq!(spread.len(), 3);
     // The same medians, one study at a time.
     let medians: Vec<Vec<f64>> = (7..10)
         .map(|seed| {
@@ -482,8 +485,29 @@ fn density_study_spread_summarises_the_medians_of_repeated_studies() {
     );
     let falls = medians.iter().filter(|m| m[1] < m[0]).count();
     assert_eq!(spread[1].sas_falls, falls);
+    // Where each study's SAS curve peaks, and how many rise and fall.
+    let peak_at = |m: &Vec<f64>| {
+        (0..3)
+            .reduce(|a, b| if m[b] > m[a] { b } else { a })
+            .unwrap()
+    };
+    for (k, s) in spread.iter().enumerate() {
+        assert_eq!(
+            s.sas_peaks,
+            medians.iter().filter(|m| peak_at(m) == k).count()
+        );
+    }
+    assert_eq!(spread.iter().map(|s| s.sas_peaks).sum::<usize>(), 3);
+    assert_eq!(spread.iter().map(|s| s.best_peaks).sum::<usize>(), 3);
+    let inside = medians.iter().filter(|m| peak_at(m) == 1).count();
+    assert_eq!(study::rise_and_fall(&spread)[0].0, 10);
+    assert_eq!(study::rise_and_fall(&spread)[0].1, inside);
     let table = study::spread_table(&spread, 3);
-    assert!(table.contains("10x10  50%"), "{table}");
+    assert!(table.contains("10x10  40%"), "{table}");
+    assert!(
+        table.contains(&format!("in {inside} / 3 studies for SAS")),
+        "{table}"
+    );
     let png = std::env::temp_dir().join(format!("reconfcheck-spread-{}.png", std::process::id()));
     let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
     study::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();

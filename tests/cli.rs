@@ -493,3 +493,70 @@ fn a_generated_schedule_certifies_with_its_model_from_another_folder() {
     assert_eq!(c.status.code(), Some(0), "{}{text}", stderr(&c));
     assert!(text.contains("mechanics"), "{text}");
 }
+
+#[test]
+fn density_study_takes_a_growth_rule_and_refuses_an_unknown_one() {
+    let png = scratch("density-chain.png");
+    let o = bin()
+        .arg("density-study")
+        .args(["--sizes", "10", "--densities", "30,60", "--samples", "3"])
+        .args(["--repeats", "2", "--growth", "chain", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("10x10  60%"), "{table}");
+    assert!(
+        table.contains("rises to a point and falls again"),
+        "{table}"
+    );
+    assert_png(&png);
+    let o = bin()
+        .arg("density-study")
+        .args(["--growth", "spiral", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("spiral"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_random_scenario_names_its_growth_rule() {
+    let scenario = |growth: &str| {
+        format!(
+            "name = \"g\"\nalgorithm = \"active-subtraction\"\n[parameters]\nmode = \"pas\"\n\
+             [parameters.random]\nwidth = 12\nheight = 12\ndensity = 0.4\nseed = 3\n{growth}"
+        )
+    };
+    let generate = |name: &str, growth: &str| {
+        let p = write(name, &scenario(growth));
+        let out = scratch(&format!("{name}.json"));
+        let o = bin()
+            .arg("generate")
+            .arg(&p)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        (o, out)
+    };
+    let (o, member) = generate("member.toml", "");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (o, chain) = generate("chain.toml", "growth = \"chain\"\n");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_ne!(
+        std::fs::read(&member).unwrap(),
+        std::fs::read(&chain).unwrap(),
+        "the growth rule changes the configuration"
+    );
+    assert_eq!(certify(&chain).status.code(), Some(0));
+    let (o, _) = generate("spiral.toml", "growth = \"spiral\"\n");
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(
+        err.contains("spiral.toml") && err.contains("spiral"),
+        "{err}"
+    );
+}

@@ -56,6 +56,9 @@ pub struct RandomSpec {
     pub density: f64,
     #[serde(default)]
     pub seed: u64,
+    /// The growth rule (`member`, §V-B as written, unless set).
+    #[serde(default)]
+    pub growth: random::Growth,
 }
 
 /// Scenario parameters of `active-subtraction`.
@@ -156,7 +159,7 @@ impl Generator for ActiveSubtraction {
                         "give the size of a random configuration inside [parameters.random]",
                     ));
                 }
-                random::random_shape(r.width, r.height, r.density, r.seed)
+                random::random_shape_grown(r.width, r.height, r.density, r.seed, r.growth)
                     .map_err(|m| scenario.error(m))?
             }
             _ => {

@@ -4,7 +4,7 @@
 //! modules; a table and a box plot.
 
 use super::pas::{self, PasTimes};
-use super::random::random_shape;
+use super::random::{Growth, random_shape_grown};
 use super::sas;
 use crate::render::{SvgCanvas, save};
 use plotters::prelude::*;
@@ -21,6 +21,8 @@ pub struct StudyConfig {
     pub samples: usize,
     /// Base seed; sample `k` of `(size, ρ)` uses a seed derived from all four.
     pub seed: u64,
+    /// How the random desired configurations grow.
+    pub growth: Growth,
 }
 
 /// One random configuration, run with both solutions.
@@ -104,7 +106,7 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
     jobs.par_iter()
         .map(|&(size, density, k)| {
             let seed = sample_seed(cfg.seed, size, density, k);
-            let shape = random_shape(size, size, density as f64 / 100.0, seed)?;
+            let shape = random_shape_grown(size, size, density as f64 / 100.0, seed, cfg.growth)?;
             let run = sas::run(&shape)?;
             let n = run.removals.len().max(1) as f64;
             let sas_t = PasTimes::sequential(&run).time_steps() as f64;
@@ -178,6 +180,31 @@ pub struct Spread {
     /// Studies in which this box's SAS median is below the previous
     /// density's (a "fall"); 0 for the first density.
     pub sas_falls: usize,
+    /// Studies whose highest SAS median (over this size's densities) is
+    /// this box's: where the curve peaks.
+    pub sas_peaks: usize,
+    /// The same for the best-case median.
+    pub best_peaks: usize,
+}
+
+/// Per size, the studies whose curve "rises to a point and falls again"
+/// (seed 003 §VI): the highest median at neither the lowest nor the highest
+/// density. Returns `(size, SAS count, best-case count)`.
+pub fn rise_and_fall(rows: &[Spread]) -> Vec<(i32, usize, usize)> {
+    let mut out: Vec<(i32, usize, usize)> = Vec::new();
+    for (k, r) in rows.iter().enumerate() {
+        let first = k == 0 || rows[k - 1].size != r.size;
+        let last = k + 1 == rows.len() || rows[k + 1].size != r.size;
+        if first {
+            out.push((r.size, 0, 0));
+        }
+        if !first && !last {
+            let e = out.last_mut().expect("pushed at the size's first row");
+            e.1 += r.sas_peaks;
+            e.2 += r.best_peaks;
+        }
+    }
+    out
 }
 
 fn spread_len(spread: &[Spread]) -> usize {
@@ -208,6 +235,22 @@ pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> 
             let sas: Vec<f64> = medians.iter().map(|rs| rs[k].sas.median).collect();
             let best: Vec<f64> = medians.iter().map(|rs| rs[k].best.median).collect();
             let prev_same_size = k > 0 && first[k - 1].size == row.size;
+            // Where each study's curve peaks: the first of its highest medians.
+            let same_size: Vec<usize> = (0..first.len())
+                .filter(|&j| first[j].size == row.size)
+                .collect();
+            let peaks = |f: fn(&Row) -> f64| {
+                medians
+                    .iter()
+                    .filter(|rs| {
+                        let top = same_size
+                            .iter()
+                            .copied()
+                            .reduce(|a, b| if f(&rs[b]) > f(&rs[a]) { b } else { a });
+                        top == Some(k)
+                    })
+                    .count()
+            };
             let sas_falls = if prev_same_size {
                 medians
                     .iter()
@@ -223,6 +266,8 @@ pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> 
                 sas: stats(&sas),
                 best: stats(&best),
                 sas_falls,
+                sas_peaks: peaks(|r| r.sas.median),
+                best_peaks: peaks(|r| r.best.median),
             }
         })
         .collect())
@@ -231,13 +276,18 @@ pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> 
 /// The spread table, one row per `(size, density)`.
 pub fn spread_table(rows: &[Spread], repeats: usize) -> String {
     let mut s = format!(
-        "medians over {repeats} studies (mean ± sd)\nsize    rho  SAS median       best-case median   SAS median below previous ρ\n"
+        "medians over {repeats} studies (mean ± sd); studies whose SAS median is below the previous ρ's, and whose curves peak at this ρ\nsize    rho  SAS median       best-case median   SAS below previous   SAS peak   best peak\n"
     );
     for r in rows {
         let size = r.size;
         s += &format!(
-            "{size:>2}x{size:<2}  {:>2}%  {:>6.2} ± {:>4.2}    {:>6.2} ± {:>4.2}      {:>2} / {repeats}\n",
-            r.density, r.sas.0, r.sas.1, r.best.0, r.best.1, r.sas_falls
+            "{size:>2}x{size:<2}  {:>2}%  {:>6.2} ± {:>4.2}    {:>6.2} ± {:>4.2}      {:>3} / {repeats}    {:>9}   {:>9}\n",
+            r.density, r.sas.0, r.sas.1, r.best.0, r.best.1, r.sas_falls, r.sas_peaks, r.best_peaks
+        );
+    }
+    for (size, sas, best) in rise_and_fall(rows) {
+        s += &format!(
+            "{size}x{size}: the curve rises to a point and falls again (peak inside the range) in {sas} / {repeats} studies for SAS, {best} / {repeats} for the best case\n"
         );
     }
     s
@@ -291,8 +341,12 @@ pub fn plot_with_spread(
         let mut chart = ChartBuilder::on(&root)
             .caption(
                 format!(
-                    "Active subtraction: time per excluded module ({} samples per box)",
-                    cfg.samples
+                    "Active subtraction: time per excluded module ({} samples per box{})",
+                    cfg.samples,
+                    match cfg.growth {
+                        Growth::Member => "",
+                        Growth::Chain => ", chain growth",
+                    }
                 ),
                 ("sans-serif", 20),
             )
