@@ -237,7 +237,17 @@ fn an_unknown_algorithm_is_unusable_input() {
 fn the_bundled_default_runs_and_certifies() {
     let o = bin().arg("run").output().unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("CERTIFIED"));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("CERTIFIED"), "{out}");
+    // The main job is the whole certification, physics included.
+    assert!(
+        out.contains("checks: lattice, collision, mechanics"),
+        "{out}"
+    );
+    assert!(
+        out.contains("highest max_utilisation over the steps: 0.3"),
+        "{out}"
+    );
 }
 
 #[test]

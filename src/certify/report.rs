@@ -211,7 +211,7 @@ impl Report {
             }
         }
         for (k, (v, step)) in metrics {
-            let _ = writeln!(s, "max {k}: {v:.4} (step {step})");
+            let _ = writeln!(s, "highest {k} over the steps: {v:.4} (step {step})");
         }
         s
     }
