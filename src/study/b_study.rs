@@ -67,6 +67,14 @@ pub struct SweepRow {
     pub closed_elastic: usize,
 }
 
+/// A branch length the family's generator could not plan.
+#[derive(Clone, Debug, Serialize)]
+pub struct Unplanned {
+    pub b: usize,
+    /// The generator's error.
+    pub reason: String,
+}
+
 /// The whole study.
 #[derive(Clone, Debug, Serialize)]
 pub struct Study {
@@ -75,6 +83,10 @@ pub struct Study {
     pub pressure_kpa: f64,
     pub bending: Bending,
     pub rows: Vec<Row>,
+    /// Branch lengths with no schedule: they are not studied, so they
+    /// neither hold nor break `b_max` (a planner's limit is not a
+    /// connector's).
+    pub unplanned: Vec<Unplanned>,
     /// Largest studied `b` such that every `b' ≤ b` is safe (0 if none).
     pub b_max: usize,
     /// Closed-form bound for the model (cantilever with agent at the tip).
@@ -186,7 +198,9 @@ pub fn sweep_pressures() -> Vec<f64> {
 
 /// Runs the study for `lengths` with `generate(b)` producing the schedule;
 /// `progress` draws a bar over each schedule's steps on stderr (a scaffold
-/// of the sandcastle's size takes minutes per `b`).
+/// of the sandcastle's size takes minutes per `b`). A `b` the generator
+/// cannot plan is recorded in [`Study::unplanned`] and the study goes on;
+/// if no `b` can be planned, the first error is returned.
 pub fn b_study(
     family: &str,
     model: &Model,
@@ -195,8 +209,20 @@ pub fn b_study(
     progress: bool,
 ) -> Result<Study, InputError> {
     let mut rows = Vec::new();
+    let mut unplanned = Vec::new();
+    let mut first_error = None;
     for &b in lengths {
-        let schedule = generate(b)?;
+        let schedule = match generate(b) {
+            Ok(s) => s,
+            Err(e) => {
+                unplanned.push(Unplanned {
+                    b,
+                    reason: e.to_string(),
+                });
+                first_error.get_or_insert(e);
+                continue;
+            }
+        };
         let bar = progress_bar(progress, b, schedule.steps.len() + 1);
         let m = model.at_spacing(schedule.spacing.metres());
         let mut row = Row {
@@ -274,6 +300,9 @@ pub fn b_study(
         }
         rows.push(row);
     }
+    if let (true, Some(e)) = (rows.is_empty(), first_error) {
+        return Err(e);
+    }
     let prefix_max = |ok: &dyn Fn(&Row) -> bool| {
         let mut best = 0;
         let mut sorted: Vec<&Row> = rows.iter().collect();
@@ -315,6 +344,7 @@ pub fn b_study(
         pressure_kpa: model.connector.pressure / 1e3,
         bending: model.connector.bending,
         rows,
+        unplanned,
         b_max,
         closed_b_max: closed_form::cantilever_max_length(model, true),
         sweep,
@@ -363,6 +393,9 @@ impl Study {
                 r.critical_step,
                 r.critical_connector
             );
+        }
+        for u in &self.unplanned {
+            let _ = writeln!(s, "{:>4}  no schedule, not studied: {}", u.b, u.reason);
         }
         let _ = writeln!(
             s,
@@ -607,6 +640,31 @@ mod tests {
                 .windows(2)
                 .all(|w| w[0].b_max_rigid_hinge <= w[1].b_max_rigid_hinge)
         );
+    }
+
+    #[test]
+    fn a_branch_length_without_a_schedule_is_skipped_not_counted() {
+        let model = Model::default_catom();
+        let generate = |b: usize| {
+            if b == 2 {
+                Err(InputError::new("no route for module 9"))
+            } else {
+                branch_schedule(b, 3.6)
+            }
+        };
+        let st = b_study("branch", &model, &[1, 2, 3], generate, false).unwrap();
+        assert_eq!(st.rows.iter().map(|r| r.b).collect::<Vec<_>>(), [1, 3]);
+        assert_eq!(st.unplanned.len(), 1);
+        assert_eq!(st.unplanned[0].b, 2);
+        assert!(
+            st.table()
+                .contains("no schedule, not studied: no route for module 9")
+        );
+        // b = 1 and 3 hold; the gap at 2 neither holds nor breaks b_max.
+        assert_eq!(st.b_max, 3);
+        // With no schedule at all, the study fails with the first error.
+        let none = b_study("branch", &model, &[2, 2], generate, false);
+        assert!(none.unwrap_err().to_string().contains("module 9"));
     }
 
     #[test]
