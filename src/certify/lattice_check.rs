@@ -159,10 +159,12 @@ impl StepCheck for LatticeCheck {
 
         for &(a, b) in plan.attaches.iter().chain(&plan.detaches) {
             let (ca, cb) = (w.config.cell_of(a), w.config.cell_of(b));
-            if let (Some(ca), Some(cb)) = (ca, cb) {
-                if !w.lattice.are_neighbours(ca, cb) && !moving.contains(&a) && !moving.contains(&b)
-                {
-                    out.violations.push(
+            if let (Some(ca), Some(cb)) = (ca, cb)
+                && !w.lattice.are_neighbours(ca, cb)
+                && !moving.contains(&a)
+                && !moving.contains(&b)
+            {
+                out.violations.push(
                         Violation::new(
                             ViolationKind::LatchNotAdjacent,
                             step,
@@ -171,7 +173,6 @@ impl StepCheck for LatticeCheck {
                         .modules([a, b])
                         .cells([ca, cb]),
                     );
-                }
             }
         }
 

@@ -367,7 +367,7 @@ mod tests {
     fn without_a_model_the_report_says_the_mechanics_did_not_run() {
         let r = certify(&branch_schedule(1), &opts(None)).unwrap();
         assert!(r.checks.iter().any(|c| c == MECHANICS_NOT_RUN));
-        assert!(r.per_step[0].metrics.get("max_utilisation").is_none());
+        assert!(!r.per_step[0].metrics.contains_key("max_utilisation"));
     }
 
     #[test]

@@ -113,13 +113,13 @@ impl World {
 
     fn check_cell(&self, c: Cell) -> Result<(), String> {
         self.lattice.check_cell(c)?;
-        if let Some(g) = self.ground {
-            if g.is_ground_cell(self.lattice, c) {
-                return Err(format!(
-                    "cell {c} is inside the ground (below layer {})",
-                    g.layer
-                ));
-            }
+        if let Some(g) = self.ground
+            && g.is_ground_cell(self.lattice, c)
+        {
+            return Err(format!(
+                "cell {c} is inside the ground (below layer {})",
+                g.layer
+            ));
         }
         Ok(())
     }

@@ -193,10 +193,10 @@ impl Scan<'_> {
     /// applies.
     fn planar_gap(&self, half: usize) -> Option<f64> {
         let k = self.mover.half_axis(half);
-        if let Path::Rolling(r) = self.other {
-            if r.half_axis(half).cross(k).length() > 1e-12 {
-                return None;
-            }
+        if let Path::Rolling(r) = self.other
+            && r.half_axis(half).cross(k).length() > 1e-12
+        {
+            return None;
         }
         let s = 0.25 + 0.5 * half as f64;
         let along = |u: DVec3| -self.other.support(s, -u) - self.mover.support(s, u);

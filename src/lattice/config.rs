@@ -117,15 +117,15 @@ impl Configuration {
                 stack.push((m, c));
             }
         }
-        if ground.is_none() && fixed.is_empty() {
-            if let Some((m, c)) = self
+        if ground.is_none()
+            && fixed.is_empty()
+            && let Some((m, c)) = self
                 .modules()
                 .into_iter()
                 .find(|(m, _)| !exclude.contains(m))
-            {
-                seen.insert(m);
-                stack.push((m, c));
-            }
+        {
+            seen.insert(m);
+            stack.push((m, c));
         }
         while let Some((m, c)) = stack.pop() {
             for (o, n) in self.latched_neighbours(lattice, m, c, exclude, latched) {

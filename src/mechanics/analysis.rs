@@ -296,10 +296,8 @@ impl Analyzer {
         );
         let standard = (ra - 0.5 * l.normal).length() < 1e-12
             && rb.is_none_or(|r| (r + 0.5 * l.normal).length() < 1e-12);
-        if standard {
-            if let Some(b) = self.blocks.get(&key) {
-                return b.clone();
-            }
+        if standard && let Some(b) = self.blocks.get(&key) {
+            return b.clone();
         }
         let d = link_stiffness(l, &self.link_springs(l, sliding));
         let ga = transfer(ra);
@@ -589,10 +587,10 @@ impl Analyzer {
         if !s.bodies[l.a].fixed {
             e -= lb.ga * q[l.a];
         }
-        if let End::Body(b) = l.b {
-            if !s.bodies[b].fixed {
-                e += lb.gb * q[b];
-            }
+        if let End::Body(b) = l.b
+            && !s.bodies[b].fixed
+        {
+            e += lb.gb * q[b];
         }
         let sf = lb.d * e;
         let f = DVec3::new(sf[0], sf[1], sf[2]);
@@ -744,12 +742,13 @@ impl Components {
             x
         }
         for l in &s.links {
-            if let End::Body(b) = l.b {
-                if !s.bodies[l.a].fixed && !s.bodies[b].fixed {
-                    let (ra, rb) = (find(&mut parent, l.a), find(&mut parent, b));
-                    if ra != rb {
-                        parent[ra.max(rb)] = ra.min(rb);
-                    }
+            if let End::Body(b) = l.b
+                && !s.bodies[l.a].fixed
+                && !s.bodies[b].fixed
+            {
+                let (ra, rb) = (find(&mut parent, l.a), find(&mut parent, b));
+                if ra != rb {
+                    parent[ra.max(rb)] = ra.min(rb);
                 }
             }
         }

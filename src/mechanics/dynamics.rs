@@ -115,14 +115,14 @@ pub fn simulate(model: &Model, s: &Structure, duration: f64) -> Outcome {
         world.step();
         if step + 1 == read_at {
             for (li, j) in joints.iter().enumerate() {
-                if let Some(h) = j {
-                    if let Some(joint) = world.impulse_joints.get(*h) {
-                        let imp = joint.impulses;
-                        // The stored impulse is one solver iteration's
-                        // share (SPEC §4.5): force = impulse · iterations / dt.
-                        let k = iterations as f64 / dt;
-                        out.joint_force[li] = Some([imp[0] * k, imp[1] * k, imp[2] * k]);
-                    }
+                if let Some(h) = j
+                    && let Some(joint) = world.impulse_joints.get(*h)
+                {
+                    let imp = joint.impulses;
+                    // The stored impulse is one solver iteration's
+                    // share (SPEC §4.5): force = impulse · iterations / dt.
+                    let k = iterations as f64 / dt;
+                    out.joint_force[li] = Some([imp[0] * k, imp[1] * k, imp[2] * k]);
                 }
             }
         }

@@ -153,6 +153,16 @@ pub fn jacobi_pcg(
     pcg(k, &mut apply, f, x, tol, max_iter)
 }
 
+/// `G(r)`: generalised displacement (translation, rotation) of a point at
+/// offset `r` from a rigid body's reference point, from the body's `(u, θ)`:
+/// `u + θ × r = u − [r]ₓ θ`.
+pub fn transfer(r: glam::DVec3) -> Block {
+    let mut g = Block::identity();
+    let s = nalgebra::Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0);
+    g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
+    g
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -193,14 +203,4 @@ pub(crate) mod tests {
         let s2 = jacobi_pcg(&k, &f, &mut x, 1e-10, 1000);
         assert_eq!(s2.iterations, 0);
     }
-}
-
-/// `G(r)`: generalised displacement (translation, rotation) of a point at
-/// offset `r` from a rigid body's reference point, from the body's `(u, θ)`:
-/// `u + θ × r = u − [r]ₓ θ`.
-pub fn transfer(r: glam::DVec3) -> Block {
-    let mut g = Block::identity();
-    let s = nalgebra::Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0);
-    g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
-    g
 }

@@ -224,8 +224,8 @@ fn superposition_of_mover_loads_holds() {
         let s = structure(&FccLattice, None, &cells[..6], &[0, 1], &[]);
         tight(model.clone()).analyse(&s)
     };
-    let a = run(&[mv1.clone()], &[m2]);
-    let b = run(&[mv2.clone()], &[m1]);
+    let a = run(std::slice::from_ref(&mv1), &[m2]);
+    let b = run(std::slice::from_ref(&mv2), &[m1]);
     let ab = run(&[mv1, mv2], &[]);
     let scale = model.weight() * model.spacing;
     for i in 0..none.links.len() {

@@ -85,7 +85,7 @@ pub fn islands_with_walkers(
             }
             let from = config.cell_of(m).expect("walker");
             let Some((pivot, targets)) = crate::algorithms::random_walk::random_pivot_and_targets(
-                &config, from, &in_top, &claimed, &leaving, &mut rng,
+                &config, from, in_top, &claimed, &leaving, &mut rng,
             ) else {
                 continue;
             };

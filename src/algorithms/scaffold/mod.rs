@@ -148,7 +148,7 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
         // of its ground tile, then any, at a penalty: an entry point hemmed
         // in by finished branches cannot send modules anywhere.
         let preferred = s.source_for(c);
-        let ground = preferred.add(scaffold::Dir::Z.epl_offset().scale(-1));
+        let ground = preferred.offset(scaffold::Dir::Z.epl_offset().scale(-1));
         let ground = all_sources
             .iter()
             .map(|&(g, _)| g)

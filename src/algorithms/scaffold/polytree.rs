@@ -45,23 +45,23 @@ impl Polytree {
             let mut tips = Vec::new();
             for &u in &t.ingoing_up {
                 if t.layer > 0 {
-                    ps.push(r.add(u.step().scale(-b)));
-                    tips.extend(idx(r.add(u.step().scale(-1))));
+                    ps.push(r.offset(u.step().scale(-b)));
+                    tips.extend(idx(r.offset(u.step().scale(-1))));
                 }
             }
             for &h in &t.ingoing_h {
-                ps.push(r.add(h.step().scale(-b)));
-                tips.extend(idx(r.add(h.step().scale(-1))));
+                ps.push(r.offset(h.step().scale(-b)));
+                tips.extend(idx(r.offset(h.step().scale(-1))));
             }
             parents.insert(r, ps);
             preds[root] = tips;
             let mut early = vec![root];
             let mut horizontal_tips = Vec::new();
             for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
-                let first = idx(r.add(d.step())).expect("branch module");
+                let first = idx(r.offset(d.step())).expect("branch module");
                 preds[first] = vec![root];
                 early.push(first);
-                horizontal_tips.push(idx(r.add(d.step().scale(len as i32))).expect("tip"));
+                horizontal_tips.push(idx(r.offset(d.step().scale(len as i32))).expect("tip"));
             }
             // A first branch module lies between two supports (X1 between
             // S_Z and S_RZ): it goes in before them (bridging constraint).
@@ -82,29 +82,29 @@ impl Polytree {
             let mut lone_prev: Option<usize> = None;
             for &(d, len) in &unsupported {
                 for m in 1..=len as i32 {
-                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    let c = idx(r.offset(d.step().scale(m))).expect("branch module");
                     preds[c] = if m == 1 {
                         let mut p = firsts.clone();
                         p.extend(lone_prev);
                         p
                     } else {
-                        vec![idx(r.add(d.step().scale(m - 1))).expect("previous")]
+                        vec![idx(r.offset(d.step().scale(m - 1))).expect("previous")]
                     };
                 }
-                let tip = idx(r.add(d.step().scale(len as i32))).expect("tip");
+                let tip = idx(r.offset(d.step().scale(len as i32))).expect("tip");
                 early.push(tip);
                 lone_prev = Some(tip);
             }
             for &u in &t.ingoing_up {
-                let si = idx(r.add(u.mirror().support_offset())).expect("support exists");
+                let si = idx(r.offset(u.mirror().support_offset())).expect("support exists");
                 preds[si] = early.clone();
                 early.push(si);
             }
             for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
                 for m in 2..=len as i32 {
-                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    let c = idx(r.offset(d.step().scale(m))).expect("branch module");
                     let mut p = early.clone();
-                    p.push(idx(r.add(d.step().scale(m - 1))).expect("previous"));
+                    p.push(idx(r.offset(d.step().scale(m - 1))).expect("previous"));
                     preds[c] = p;
                 }
             }
@@ -116,13 +116,13 @@ impl Polytree {
                 .collect();
             for &(d, len) in &ups {
                 for m in 1..=len as i32 {
-                    let c = idx(r.add(d.step().scale(m))).expect("branch module");
+                    let c = idx(r.offset(d.step().scale(m))).expect("branch module");
                     preds[c] = if m == 1 {
                         let mut p = early.clone();
                         p.extend(&horizontal_tips);
                         p
                     } else {
-                        vec![idx(r.add(d.step().scale(m - 1))).expect("previous")]
+                        vec![idx(r.offset(d.step().scale(m - 1))).expect("previous")]
                     };
                 }
             }

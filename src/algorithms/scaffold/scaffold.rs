@@ -189,7 +189,7 @@ impl Scaffold {
         for &r in &roots {
             let mut t = tiles[&r].clone();
             for u in Dir::UPWARD {
-                let from = r.add(u.step().scale(-bi));
+                let from = r.offset(u.step().scale(-bi));
                 if t.layer == 0 || is_tile(from) {
                     t.ingoing_up.push(u);
                 }
@@ -205,7 +205,7 @@ impl Scaffold {
                 )));
             }
             for h in [Dir::X, Dir::Y] {
-                if is_tile(r.add(h.step().scale(-bi))) {
+                if is_tile(r.offset(h.step().scale(-bi))) {
                     t.ingoing_h.push(h);
                 }
             }
@@ -219,13 +219,13 @@ impl Scaffold {
                 Dir::RevZ,
                 Dir::LZ,
             ] {
-                let far = r.add(d.step().scale(bi));
+                let far = r.offset(d.step().scale(bi));
                 let opp = matches!(d, Dir::OppX | Dir::OppY);
                 if opp && is_tile(far) {
                     continue; // that tile grows its own X / Y branch
                 }
                 let mut len = 0;
-                while len < bi - 1 && shape.contains(r.add(d.step().scale(len + 1))) {
+                while len < bi - 1 && shape.contains(r.offset(d.step().scale(len + 1))) {
                     len += 1;
                 }
                 if is_tile(far) && len < bi - 1 {
@@ -280,7 +280,7 @@ impl Scaffold {
                     Component {
                         tile: r,
                         part: Part::Support(s),
-                        cell: r.add(s.support_offset()),
+                        cell: r.offset(s.support_offset()),
                     },
                     &mut components,
                 )?;
@@ -291,7 +291,7 @@ impl Scaffold {
                         Component {
                             tile: r,
                             part: Part::Branch(d, m),
-                            cell: r.add(d.step().scale(m as i32)),
+                            cell: r.offset(d.step().scale(m as i32)),
                         },
                         &mut components,
                     )?;
@@ -306,10 +306,10 @@ impl Scaffold {
         let mut sand_roots: rustc_hash::FxHashSet<Skew> = Default::default();
         for (&g, _) in info.iter().filter(|(_, t)| t.layer == 0) {
             for u in Dir::UPWARD {
-                let q = g.add(u.step().scale(-bi));
+                let q = g.offset(u.step().scale(-bi));
                 sand_roots.insert(q);
                 for m in 0..bi {
-                    let c = q.add(u.step().scale(m));
+                    let c = q.offset(u.step().scale(m));
                     if seen.insert(c) {
                         sandbox.push(c);
                     }
@@ -320,9 +320,9 @@ impl Scaffold {
         sr.sort();
         for &q in &sr {
             for h in [Dir::X, Dir::Y] {
-                if sand_roots.contains(&q.add(h.step().scale(bi))) {
+                if sand_roots.contains(&q.offset(h.step().scale(bi))) {
                     for m in 1..bi {
-                        let c = q.add(h.step().scale(m));
+                        let c = q.offset(h.step().scale(m));
                         if seen.insert(c) {
                             sandbox.push(c);
                         }
@@ -344,7 +344,7 @@ impl Scaffold {
     /// Entry point (source cell) of ground tile `g` for modules arriving
     /// along the sandbox branch of direction `u`.
     pub fn source(&self, g: Skew, u: Dir) -> Skew {
-        g.add(u.epl_offset())
+        g.offset(u.epl_offset())
     }
 
     /// The ingoing upward branch through which `c` is fed (§3.3.2: the EPL
@@ -380,7 +380,7 @@ impl Scaffold {
             if t.layer == 0 {
                 return self.source(tile, d);
             }
-            tile = tile.add(d.step().scale(-self.b));
+            tile = tile.offset(d.step().scale(-self.b));
             let parent = &self.tiles[&tile];
             let next = d.mirror();
             // Semi-convexity guarantees the mirror branch (checked in build).
@@ -488,9 +488,9 @@ mod tests {
             for u in Dir::UPWARD {
                 let src = s.source(g, u);
                 assert!(!sand.contains(&src) && !s.index.contains_key(&src));
-                let second_last = g.add(u.step().scale(-2));
+                let second_last = g.offset(u.step().scale(-2));
                 assert!(l.are_neighbours(src.cell(), second_last.cell()), "{u:?}");
-                let support = g.add(u.mirror().support_offset());
+                let support = g.offset(u.mirror().support_offset());
                 assert!(l.are_neighbours(src.cell(), support.cell()), "{u:?}");
             }
         }

@@ -22,7 +22,8 @@ impl Skew {
         Skew { x, y, z }
     }
 
-    pub fn add(self, o: Skew) -> Skew {
+    /// The cell `o` away from this one.
+    pub fn offset(self, o: Skew) -> Skew {
         Skew::new(self.x + o.x, self.y + o.y, self.z + o.z)
     }
 
