@@ -212,26 +212,19 @@ pub fn replay(
 ) -> Result<(), crate::error::InputError> {
     let check = LoadCheck::new(model, schedule.spacing.metres(), incremental);
     let mut world = World::initial(schedule)?;
-    for (k, step) in schedule.steps.iter().enumerate() {
-        let plan = world.resolve(k + 1, step)?;
-        let mut out = StepOutcome {
-            violations: plan.violations.clone(),
-            ..Default::default()
-        };
-        let ctx = StepContext {
-            world: &world,
-            plan: &plan,
-        };
-        super::LatticeCheck.check(&ctx, &mut out);
-        let movers: Vec<MoverSpec> = plan.resolved_moves();
-        let (s, a) = check.analyse(&world, &plan.moving, &movers);
-        visit(k + 1, &s, &a, &out);
-        let clashes = world.apply(&plan);
-        if !clashes.is_empty() {
+    for k in 0..schedule.steps.len() {
+        let (_, _, clashes) = super::advance(&mut world, schedule, k, |ctx| {
+            let mut out = StepOutcome::of_plan(ctx.plan);
+            super::LatticeCheck.check(ctx, &mut out);
+            let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
+            let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
+            visit(k + 1, &s, &a, &out);
+        })?;
+        if let Some(clash) = clashes.first() {
             return Err(crate::error::InputError::new(format!(
                 "step {}: {}",
                 k + 1,
-                clashes[0].message
+                clash.message
             )));
         }
     }

@@ -86,6 +86,33 @@ pub struct StepOutcome {
     pub metrics: BTreeMap<String, f64>,
 }
 
+impl StepOutcome {
+    /// An outcome that starts with what resolving the step's events found.
+    pub fn of_plan(plan: &StepPlan) -> StepOutcome {
+        StepOutcome {
+            violations: plan.violations.clone(),
+            ..Default::default()
+        }
+    }
+}
+
+/// One step of a replay, the loop body that certification, its parallel
+/// ranges and [`load_check::replay`] share: resolves step `k` (0-based) of
+/// `schedule` against `world`, shows `inspect` the scene before the step
+/// with its plan, then applies the step. Returns what `inspect` returned,
+/// the plan and the clashes of applying it.
+pub fn advance<R>(
+    world: &mut World,
+    schedule: &Schedule,
+    k: usize,
+    inspect: impl FnOnce(&StepContext<'_>) -> R,
+) -> Result<(R, StepPlan, Vec<Violation>), InputError> {
+    let plan = world.resolve(k + 1, &schedule.steps[k])?;
+    let seen = inspect(&StepContext { world, plan: &plan });
+    let clashes = world.apply(&plan);
+    Ok((seen, plan, clashes))
+}
+
 /// One kind of check, run on every step of a schedule.
 pub trait StepCheck: Send + Sync {
     /// Short name listed in the report.
@@ -229,24 +256,18 @@ pub fn certify_with(
         );
     }
 
-    for (k, step) in schedule.steps.iter().enumerate() {
+    for k in 0..schedule.steps.len() {
         let index = k + 1;
         if !ranged.is_empty() && k % range == 0 {
             starts.push((k, world.clone()));
         }
-        let plan = world.resolve(index, step)?;
-        let mut out = StepOutcome {
-            violations: plan.violations.clone(),
-            ..Default::default()
-        };
-        let ctx = StepContext {
-            world: &world,
-            plan: &plan,
-        };
-        for c in &inline {
-            c.check(&ctx, &mut out);
-        }
-        let clashes = world.apply(&plan);
+        let (mut out, plan, clashes) = advance(&mut world, schedule, k, |ctx| {
+            let mut out = StepOutcome::of_plan(ctx.plan);
+            for c in &inline {
+                c.check(ctx, &mut out);
+            }
+            out
+        })?;
         let stop = !clashes.is_empty();
         let tunnels = plan
             .moves
@@ -338,16 +359,13 @@ fn ranges_in_parallel(
             let mut world = start.clone();
             let mut found = Vec::new();
             for k in *first..(first + range).min(last) {
-                let plan = world.resolve(k + 1, &schedule.steps[k])?;
-                let mut out = StepOutcome::default();
-                let ctx = StepContext {
-                    world: &world,
-                    plan: &plan,
-                };
-                for c in &checks {
-                    c.check(&ctx, &mut out);
-                }
-                world.apply(&plan);
+                let (out, _, _) = advance(&mut world, schedule, k, |ctx| {
+                    let mut out = StepOutcome::default();
+                    for c in &checks {
+                        c.check(ctx, &mut out);
+                    }
+                    out
+                })?;
                 found.push((k, out));
                 bar.inc(1);
             }
