@@ -5,11 +5,19 @@
 //!
 //! * [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
 //! * [`schedule`] — the versioned schedule format shared by every seed;
-//! * [`geometry`] — module bodies and continuous sweeps;
+//! * [`scenario`] — runnable cases: a generator's name and its inputs;
+//! * [`geometry`] — module bodies, continuous sweeps, and the motion rules
+//!   derived from them;
+//! * [`mechanics`] — the frame model of a structure: equilibrium, connector
+//!   loads, capacities;
 //! * [`certify`] — replays a schedule and runs every check on every step;
-//! * [`algorithms`] — generators that emit schedules (depend on `lattice`
-//!   and `schedule`, never on `certify`);
-//! * [`scenario`] — runnable cases that name a generator and its inputs.
+//! * [`algorithms`] — generators that emit schedules (depend on `lattice`,
+//!   `schedule` and `geometry`'s motion rules, never on `mechanics` or
+//!   `certify`);
+//! * [`study`] — questions asked over many schedules (the b-study, load
+//!   maps, synthetic benchmarks).
+//!
+//! [`render`] (SVG → PNG) is a leaf that any layer may draw with.
 
 pub mod algorithms;
 pub mod certify;
