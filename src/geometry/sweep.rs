@@ -207,7 +207,7 @@ impl Scan<'_> {
 /// Sweeps `mover` against `other` over `s ∈ [0, 1]` with tolerance `eps`.
 ///
 /// Each half-sweep is either proven free of penetration at once by the
-/// planar certificate ([`Scan::planar_gap`]) — then sampled only to find
+/// planar certificate (`Scan::planar_gap`) — then sampled only to find
 /// sliding contacts — or swept by conservative advancement. Contacts within
 /// [`LATCH_WINDOW`] of either end are the latched contacts of the start and
 /// target cells and are not reported.
