@@ -172,6 +172,9 @@ enum Command {
         /// curve owes to the generator.
         #[arg(long, value_enum, default_value = "member")]
         growth: GrowthArg,
+        /// Also write every sample, the box summaries and the spread as JSON.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
         /// Box plot (PNG, or SVG by extension).
         #[arg(short, long)]
         output: PathBuf,
@@ -310,6 +313,7 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             seed,
             repeats,
             growth,
+            json,
             output,
         } => {
             use reconfcheck::algorithms::active_subtraction::{random::Growth, study};
@@ -344,6 +348,10 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             }
             study::plot_with_spread(&cfg, &rows, &spread, &output).map_err(Failure::Output)?;
             eprintln!("wrote {}", output.display());
+            if let Some(p) = &json {
+                write(p, &study::to_json(&cfg, &samples, &rows, &spread))?;
+                eprintln!("wrote {}", p.display());
+            }
             Ok(0)
         }
         Command::BStudy {

@@ -505,13 +505,16 @@ fn a_generated_schedule_certifies_with_its_model_from_another_folder() {
 }
 
 #[test]
-fn density_study_takes_a_growth_rule_and_refuses_an_unknown_one() {
+fn density_study_takes_a_growth_rule_writes_json_and_refuses_an_unknown_rule() {
     let png = scratch("density-chain.png");
+    let json = scratch("density-chain.json");
     let o = bin()
         .arg("density-study")
         .args(["--sizes", "10", "--densities", "30,60", "--samples", "3"])
         .args(["--repeats", "2", "--growth", "chain", "-o"])
         .arg(&png)
+        .arg("--json")
+        .arg(&json)
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -522,6 +525,19 @@ fn density_study_takes_a_growth_rule_and_refuses_an_unknown_one() {
         "{table}"
     );
     assert_png(&png);
+    let doc: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(doc["format"], "reconfcheck-density-study");
+    assert_eq!(doc["config"]["growth"], "chain");
+    assert_eq!(doc["samples"].as_array().unwrap().len(), 2 * 3);
+    assert_eq!(doc["rows"].as_array().unwrap().len(), 2);
+    assert_eq!(doc["spread"][1]["repeats"], 2);
+    assert_eq!(doc["rise_and_fall"][0]["size"], 10);
+    // The JSON and the table tell the same medians.
+    let median = doc["rows"][1]["sas"]["median"].as_f64().unwrap();
+    assert!(
+        table.contains(&format!("{median:.2}")),
+        "{median} not in {table}"
+    );
     let o = bin()
         .arg("density-study")
         .args(["--growth", "spiral", "-o"])

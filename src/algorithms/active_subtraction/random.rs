@@ -16,10 +16,10 @@ use super::shape::{Shape, neighbours4};
 use crate::lattice::Cell;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Which included module the next random neighbour is added to.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Growth {
     /// §V-B as written: "the next module to add a neighbor to is also

@@ -9,10 +9,11 @@ use super::sas;
 use crate::render::{SvgCanvas, save};
 use plotters::prelude::*;
 use rayon::prelude::*;
+use serde::Serialize;
 use std::path::Path;
 
 /// What to sample.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct StudyConfig {
     /// Side lengths of the initial squares.
     pub sizes: Vec<i32>,
@@ -26,7 +27,7 @@ pub struct StudyConfig {
 }
 
 /// One random configuration, run with both solutions.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Sample {
     pub size: i32,
     pub density: u32,
@@ -40,7 +41,7 @@ pub struct Sample {
 }
 
 /// Quartiles and whiskers (1.5 IQR, clipped to the data) of a sample set.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Summary {
     pub low: f64,
     pub q1: f64,
@@ -126,7 +127,7 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
 }
 
 /// The summaries of one `(size, density)` box.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Row {
     pub size: i32,
     pub density: u32,
@@ -167,7 +168,7 @@ pub fn summarise(cfg: &StudyConfig, samples: &[Sample]) -> Vec<Row> {
 /// `cfg.seed, cfg.seed + 1, …`, of the SAS and best-case medians per
 /// `(size, density)`. Tells a trend from the noise of one 80-sample study
 /// (seed 003's Fig. 10 is one such study).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Spread {
     pub size: i32,
     pub density: u32,
@@ -291,6 +292,26 @@ pub fn spread_table(rows: &[Spread], repeats: usize) -> String {
         );
     }
     s
+}
+
+/// The whole study as JSON: the configuration, every sample, the box
+/// summaries and, when the study was repeated, the spread of the medians
+/// and the per-size counts of curves that rise and fall.
+pub fn to_json(cfg: &StudyConfig, samples: &[Sample], rows: &[Row], spread: &[Spread]) -> String {
+    let rise_and_fall: Vec<serde_json::Value> = rise_and_fall(spread)
+        .into_iter()
+        .map(|(size, sas, best)| serde_json::json!({"size": size, "sas": sas, "best": best}))
+        .collect();
+    let doc = serde_json::json!({
+        "format": "reconfcheck-density-study",
+        "version": 1,
+        "config": cfg,
+        "samples": samples,
+        "rows": rows,
+        "spread": spread,
+        "rise_and_fall": rise_and_fall,
+    });
+    serde_json::to_string_pretty(&doc).expect("the study serialises")
 }
 
 /// The summary table, one row per `(size, density)`.
