@@ -149,6 +149,22 @@ fn an_unknown_module_id_is_named_with_its_step() {
 }
 
 #[test]
+fn a_cell_beyond_the_coordinate_range_is_unusable_input() {
+    // Found by tests/fuzz.rs: i32::MIN as a coordinate overflowed the
+    // neighbour arithmetic.
+    let mut s = walk();
+    s["steps"][1]["events"][0]["to"] = json!([-2147483648i64, 0, 1]);
+    assert_input_error(
+        "huge.json",
+        &s.to_string(),
+        &["step 2", "module 100", "beyond ±1048576"],
+    );
+    let mut s = walk();
+    s["modules"][4]["cell"] = json!([0, 2000000, 0]);
+    assert_input_error("huge-module.json", &s.to_string(), &["module 4", "beyond"]);
+}
+
+#[test]
 fn a_move_to_a_non_neighbour_cell_is_unusable_input() {
     let mut s = walk();
     s["steps"][1]["events"][0]["to"] = json!([4, 0, 1]);

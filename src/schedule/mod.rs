@@ -18,6 +18,10 @@ pub use units::Length;
 pub const FORMAT: &str = "reconfcheck-schedule";
 /// The schedule format version this build reads and writes.
 pub const VERSION: u32 = 1;
+/// Largest coordinate of a cell or ground layer, in lattice units (2²⁰:
+/// about 3.8 km of 3.6 mm catoms). Neighbour and sweep arithmetic stays
+/// far from `i32` overflow below it.
+pub const MAX_COORDINATE: i32 = 1 << 20;
 
 /// A reconfiguration schedule.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -156,6 +160,7 @@ impl Schedule {
         let schedule: Schedule = serde_json::from_str(text)
             .map_err(|e| InputError::new(format!("not a valid schedule: {e}")).in_file(origin))?;
         schedule.check_header().map_err(|e| e.in_file(origin))?;
+        schedule.check_extent().map_err(|e| e.in_file(origin))?;
         Ok(schedule)
     }
 
@@ -169,6 +174,54 @@ impl Schedule {
     /// Writes the schedule as JSON (compact: schedules get large).
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).expect("schedules serialise")
+    }
+
+    /// Refuses cells and ground layers beyond [`MAX_COORDINATE`], naming
+    /// the step and the module.
+    fn check_extent(&self) -> Result<(), InputError> {
+        let far = |c: &Cell| {
+            [c.x, c.y, c.z]
+                .iter()
+                .any(|v| v.unsigned_abs() > MAX_COORDINATE as u32)
+        };
+        let refuse = |c: &Cell| {
+            InputError::new(format!(
+                "cell ({}, {}, {}) lies beyond ±{MAX_COORDINATE} lattice units",
+                c.x, c.y, c.z
+            ))
+        };
+        if let Some(g) = &self.ground
+            && g.layer.unsigned_abs() > MAX_COORDINATE as u32
+        {
+            return Err(InputError::new(format!(
+                "ground layer {} lies beyond ±{MAX_COORDINATE}",
+                g.layer
+            )));
+        }
+        for m in &self.modules {
+            if far(&m.cell) {
+                return Err(refuse(&m.cell).for_module(m.id));
+            }
+        }
+        if let Some(c) = self.sources.iter().chain(&self.sinks).find(|c| far(c)) {
+            return Err(refuse(c));
+        }
+        for (k, step) in self.steps.iter().enumerate() {
+            for e in &step.events {
+                let cells: Vec<&Cell> = match e {
+                    Event::Rotate { from, to, .. } | Event::Slide { from, to, .. } => {
+                        vec![from, to]
+                    }
+                    Event::Tunnel { path, .. } => path.iter().collect(),
+                    Event::Enter { cell, .. } => vec![cell],
+                    Event::Leave { .. } | Event::Attach { .. } | Event::Detach { .. } => vec![],
+                };
+                if let Some(c) = cells.into_iter().find(|c| far(c)) {
+                    return Err(refuse(c).at_step(k + 1).for_module(e.module()));
+                }
+            }
+        }
+        Ok(())
     }
 
     fn check_header(&self) -> Result<(), InputError> {
