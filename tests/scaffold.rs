@@ -175,6 +175,43 @@ fn shapes_outside_the_semi_convex_class_are_refused_with_the_reason() {
 }
 
 #[test]
+fn scaffolds_too_large_to_plan_are_refused_before_any_work() {
+    let refuse = |shape: ShapeSpec, b: u32, needle: &str| {
+        let e = scaffold_schedule(&shape, b).unwrap_err();
+        assert!(e.message.contains(needle), "{}", e.message);
+    };
+    // Sizes whose cell arithmetic would overflow i32 are refused first.
+    refuse(
+        ShapeSpec::Pyramid { h: u32::MAX },
+        u32::MAX,
+        "longer than a scaffold's largest side, 1024 cells",
+    );
+    refuse(
+        ShapeSpec::Pyramid { h: 100_000 },
+        6,
+        "a 100000-pyramid with b = 6 spans 599994 cells",
+    );
+    refuse(ShapeSpec::Cube { h: 3000, e: 3 }, 6, "spans 17997 cells");
+    // Within the extent, the module count is the limit.
+    refuse(
+        ShapeSpec::Pyramid { h: 60 },
+        8,
+        "with b = 8 would have 3342650 modules; this build plans at most 1000000",
+    );
+    let dir = std::env::temp_dir().join(format!("scaffold-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("huge.csg");
+    std::fs::write(&p, "b = 6;\ncube([1e12, 5, 5]);\n").unwrap();
+    let e = scaffold_schedule(&ShapeSpec::Csg { path: p.clone() }, 6).unwrap_err();
+    assert!(
+        e.message.contains("at most 1024 cells a side"),
+        "{}",
+        e.message
+    );
+    assert_eq!(e.file.as_deref(), Some(p.as_path()));
+}
+
+#[test]
 fn placement_curve_counts_every_module_once() {
     use reconfcheck::algorithms::scaffold::plot::placed_per_step;
     let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 2 }, 6).unwrap();

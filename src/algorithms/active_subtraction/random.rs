@@ -49,11 +49,7 @@ pub fn random_shape_grown(
     seed: u64,
     growth: Growth,
 ) -> Result<Shape, String> {
-    if width < 1 || height < 1 {
-        return Err(format!(
-            "random configuration of size {width} × {height} is empty"
-        ));
-    }
+    super::shape::check_rectangle(width, height)?;
     if !(density > 0.0 && density <= 1.0) {
         return Err(format!("density {density} is not a fraction in (0, 1]"));
     }

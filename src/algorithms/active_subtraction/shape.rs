@@ -95,6 +95,7 @@ impl Shape {
 
     /// Places the shape at the bottom-left of a larger initial rectangle.
     pub fn within(&self, width: i32, height: i32) -> Result<Shape, String> {
+        check_rectangle(width, height)?;
         if self.width > width || self.height > height {
             return Err(format!(
                 "the desired configuration ({} × {}) is not inside the initial rectangle ({width} × {height})",
@@ -239,6 +240,27 @@ impl Shape {
     }
 }
 
+/// Most modules an initial rectangle may hold (2048 × 2048): SAS takes
+/// time quadratic in the module count (seed 003 §IV).
+pub const MAX_MODULES: i64 = 1 << 22;
+
+/// Refuses an initial rectangle that is empty or larger than
+/// [`MAX_MODULES`].
+pub fn check_rectangle(width: i32, height: i32) -> Result<(), String> {
+    if width < 1 || height < 1 {
+        return Err(format!(
+            "an initial rectangle of {width} × {height} is empty"
+        ));
+    }
+    if width as i64 * height as i64 > MAX_MODULES {
+        return Err(format!(
+            "an initial rectangle of {width} × {height} modules is larger than this build's \
+             limit of {MAX_MODULES} modules"
+        ));
+    }
+    Ok(())
+}
+
 /// A cell of the plane as the paper writes it, `(x, y)`.
 pub(crate) fn xy(c: Cell) -> String {
     format!("({}, {})", c.x, c.y)
@@ -311,5 +333,12 @@ mod tests {
         let big = s.within(4, 3).unwrap();
         assert_eq!(big.included_count(), 4);
         assert!(big.contains(Cell::xy(2, 2)) && !big.contains(Cell::xy(3, 1)));
+        // Rectangles beyond the module limit are refused, not allocated.
+        assert!(
+            s.within(100_000, 100_000)
+                .unwrap_err()
+                .contains("limit of 4194304")
+        );
+        assert!(s.within(i32::MAX, i32::MAX).is_err());
     }
 }

@@ -135,21 +135,25 @@ impl CsgShape {
 
     /// Skewed-grid bounds covering the solid.
     pub fn skew_bounds(&self) -> (Skew, Skew) {
+        // Clamped far beyond any buildable extent, so that a shape of
+        // absurd size reaches the scaffold's size check instead of
+        // overflowing here.
+        let cell = |v: f64| v.clamp(-1e8, 1e8) as i32;
         let (lo, hi) = self.root.bounds();
         let s2 = std::f64::consts::SQRT_2;
-        let z0 = (lo.z * s2).floor() as i32 - 1;
-        let z1 = (hi.z * s2).ceil() as i32 + 1;
+        let z0 = cell((lo.z * s2).floor()) - 1;
+        let z1 = cell((hi.z * s2).ceil()) + 1;
         let zmax = z1.max(z0).max(0) as f64;
         let zmin = z0.min(0) as f64;
         (
             Skew::new(
-                (lo.x - zmax / 2.0).floor() as i32 - 1,
-                (lo.y - zmax / 2.0).floor() as i32 - 1,
+                cell((lo.x - zmax / 2.0).floor()) - 1,
+                cell((lo.y - zmax / 2.0).floor()) - 1,
                 z0,
             ),
             Skew::new(
-                (hi.x - zmin / 2.0).ceil() as i32 + 1,
-                (hi.y - zmin / 2.0).ceil() as i32 + 1,
+                cell((hi.x - zmin / 2.0).ceil()) + 1,
+                cell((hi.y - zmin / 2.0).ceil()) + 1,
                 z1,
             ),
         )

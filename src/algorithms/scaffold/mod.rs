@@ -47,15 +47,42 @@ pub fn motion_rules() -> Result<&'static dyn MotionRules, InputError> {
         .ok_or_else(|| InputError::new("this build derives no FCC motion rules to plan with"))
 }
 
-/// The scaffold of a shape with branch length `b`.
+/// Largest side of a scaffold's shape, in cells (3.7 m of 3.6 mm catoms):
+/// beyond it the input is refused before any work.
+pub const MAX_EXTENT: i64 = 1024;
+/// Largest scaffold planned, in modules (the sandcastle has 30,634).
+pub const MAX_MODULES: usize = 1_000_000;
+
+/// The scaffold of a shape with branch length `b`, refused (with the
+/// reason) when it is larger than [`MAX_EXTENT`] or [`MAX_MODULES`].
+
+/// A side of `extent` cells, refused beyond [`MAX_EXTENT`] before any
+/// arithmetic can overflow.
+fn side(what: &str, extent: i64) -> Result<i32, InputError> {
+    if extent > MAX_EXTENT {
+        return Err(InputError::new(format!(
+            "{what} spans {extent} cells; a scaffold spans at most {MAX_EXTENT} cells a side"
+        )));
+    }
+    Ok(extent as i32)
+}
+
 pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError> {
+    if b as i64 > MAX_EXTENT {
+        return Err(InputError::new(format!(
+            "branch length b = {b} is longer than a scaffold's largest side, {MAX_EXTENT} cells"
+        )));
+    }
     let bi = b as i32;
     match shape {
         ShapeSpec::Pyramid { h } => {
             if *h < 1 {
                 return Err(InputError::new("a pyramid needs h ≥ 1"));
             }
-            let top = (*h as i32 - 1) * bi;
+            let top = side(
+                &format!("a {h}-pyramid with b = {b}"),
+                (*h as i64 - 1) * bi as i64,
+            )?;
             Scaffold::build(
                 &Pyramid { h: *h, b },
                 b,
@@ -82,7 +109,10 @@ pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError>
                      upward branches; use b ≥ 5, or e ≤ 3 with h = 2"
                 )));
             }
-            let l = (*h as i32 - 1) * bi + *e as i32;
+            let l = side(
+                &format!("a cube of {h} tiles with e = {e}, b = {b}"),
+                (*h as i64 - 1) * bi as i64 + *e as i64,
+            )?;
             Scaffold::build(
                 &CubeShape { l },
                 b,

@@ -151,8 +151,20 @@ impl Scaffold {
                 "branch length b = {b} is too short: seed 000 §3.2.2 needs b ≥ 4 for modules to pass through a tile"
             )));
         }
-        let bi = b as i32;
         let (lo, hi) = bounds;
+        let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
+            .iter()
+            .map(|&(l, h)| h as i64 - l as i64)
+            .max()
+            .unwrap_or(0);
+        if span > super::MAX_EXTENT || b as i64 > super::MAX_EXTENT {
+            return Err(InputError::new(format!(
+                "{} spans {span} cells with b = {b}; a scaffold spans at most {} cells a side",
+                shape.describe(),
+                super::MAX_EXTENT
+            )));
+        }
+        let bi = b as i32;
         let fl = |v: i32| v.div_euclid(bi);
         let ce = |v: i32| (v + bi - 1).div_euclid(bi);
         let mut tiles: BTreeMap<Skew, Tile> = BTreeMap::new();
@@ -244,6 +256,21 @@ impl Scaffold {
                 t.branches.push((d, len as u32));
             }
             info.insert(r, t);
+        }
+        // Counted before the cells are made: a scaffold too large to plan
+        // is refused in a moment, not after minutes of building.
+        let modules: usize = info
+            .values()
+            .map(|t| {
+                1 + t.ingoing_up.len() + t.branches.iter().map(|&(_, l)| l as usize).sum::<usize>()
+            })
+            .sum();
+        if modules > super::MAX_MODULES {
+            return Err(InputError::new(format!(
+                "the scaffold of {} with b = {b} would have {modules} modules; this build plans at most {}",
+                shape.describe(),
+                super::MAX_MODULES
+            )));
         }
 
         let mut components = Vec::new();
