@@ -53,9 +53,6 @@ pub const MAX_EXTENT: i64 = 1024;
 /// Largest scaffold planned, in modules (the sandcastle has 30,634).
 pub const MAX_MODULES: usize = 1_000_000;
 
-/// The scaffold of a shape with branch length `b`, refused (with the
-/// reason) when it is larger than [`MAX_EXTENT`] or [`MAX_MODULES`].
-
 /// A side of `extent` cells, refused beyond [`MAX_EXTENT`] before any
 /// arithmetic can overflow.
 fn side(what: &str, extent: i64) -> Result<i32, InputError> {
@@ -67,6 +64,8 @@ fn side(what: &str, extent: i64) -> Result<i32, InputError> {
     Ok(extent as i32)
 }
 
+/// The scaffold of a shape with branch length `b`, refused (with the
+/// reason) when it is larger than [`MAX_EXTENT`] or [`MAX_MODULES`].
 pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError> {
     if b as i64 > MAX_EXTENT {
         return Err(InputError::new(format!(
