@@ -34,6 +34,19 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Runs `cmd`, asserts that it exits 0, and returns its standard output.
+fn succeed(cmd: &mut Command) -> String {
+    let o = cmd.output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A JSON file a command wrote.
+fn read_json(path: &Path) -> Value {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_slice(&bytes).unwrap()
+}
+
 /// A valid FCC schedule: one catom rolling twice over a fixed platform.
 fn walk() -> Value {
     let mut modules: Vec<Value> = (0..3)
@@ -316,7 +329,7 @@ fn the_mechanics_check_runs_on_square_lattice_schedules_with_a_model() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let r: Value = serde_json::from_slice(&std::fs::read(out).unwrap()).unwrap();
+    let r: Value = read_json(&out);
     assert!(
         r["checks"]
             .as_array()
@@ -351,23 +364,21 @@ fn b_study_of_the_pyramid_family_writes_a_table_a_plot_and_json() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let png = scratch("b-pyramid.png");
     let json = scratch("b-pyramid.json");
-    let o = bin()
-        .arg("b-study")
-        .args(["--family", "pyramid", "--b-min", "4", "--b-max", "5"])
-        .arg("--model")
-        .arg(root.join("models/catom-3.6mm.toml"))
-        .arg("--plot")
-        .arg(&png)
-        .arg("--json")
-        .arg(&json)
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let table = String::from_utf8_lossy(&o.stdout);
+    let table = succeed(
+        bin()
+            .arg("b-study")
+            .args(["--family", "pyramid", "--b-min", "4", "--b-max", "5"])
+            .arg("--model")
+            .arg(root.join("models/catom-3.6mm.toml"))
+            .arg("--plot")
+            .arg(&png)
+            .arg("--json")
+            .arg(&json),
+    );
     assert!(table.contains("family 'pyramid'"), "{table}");
     assert!(table.contains("largest safe b at 100 kPa"), "{table}");
     assert_png(&png);
-    let st: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let st: Value = read_json(&json);
     let rows = st["rows"].as_array().unwrap();
     assert_eq!(
         rows.iter()
@@ -426,7 +437,7 @@ fn b_study_of_a_csg_shape_checks_its_scaffold_for_each_b() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let st: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let st: Value = read_json(&json);
     let rows = st["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
     for r in rows {
@@ -524,24 +535,22 @@ fn a_generated_schedule_certifies_with_its_model_from_another_folder() {
 fn density_study_takes_a_growth_rule_writes_json_and_refuses_an_unknown_rule() {
     let png = scratch("density-chain.png");
     let json = scratch("density-chain.json");
-    let o = bin()
-        .arg("density-study")
-        .args(["--sizes", "10", "--densities", "30,60", "--samples", "3"])
-        .args(["--repeats", "2", "--growth", "chain", "-o"])
-        .arg(&png)
-        .arg("--json")
-        .arg(&json)
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let table = String::from_utf8_lossy(&o.stdout);
+    let table = succeed(
+        bin()
+            .arg("density-study")
+            .args(["--sizes", "10", "--densities", "30,60", "--samples", "3"])
+            .args(["--repeats", "2", "--growth", "chain", "-o"])
+            .arg(&png)
+            .arg("--json")
+            .arg(&json),
+    );
     assert!(table.contains("10x10  60%"), "{table}");
     assert!(
         table.contains("rises to a point and falls again"),
         "{table}"
     );
     assert_png(&png);
-    let doc: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let doc: Value = read_json(&json);
     assert_eq!(doc["format"], "reconfcheck-density-study");
     assert_eq!(doc["config"]["growth"], "chain");
     assert_eq!(doc["samples"].as_array().unwrap().len(), 2 * 3);

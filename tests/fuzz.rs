@@ -2,8 +2,9 @@
 //! a value replaced by one of another kind or an extreme one, a key or an
 //! element deleted, a step duplicated) are either refused as input errors
 //! naming the file or certified with a verdict — through every check,
-//! collision sweeps and mechanics included. `PROPTEST_CASES=20000 cargo
-//! test --test fuzz` searches longer.
+//! collision sweeps and mechanics included. The same for the shape files:
+//! character-level edits of a CSG file and of a 2D grid file are refused or
+//! parsed. `PROPTEST_CASES=20000 cargo test --test fuzz` searches longer.
 
 use proptest::prelude::*;
 use reconfcheck::algorithms::random_walk::{WalkParams, walk};
@@ -144,6 +145,125 @@ proptest! {
             Ok(Ok(_)) => {}
             Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.json"), "{e}"),
             Err(_) => prop_assert!(false, "panicked on {text}"),
+        }
+    }
+}
+
+/// Pieces that CSG and grid files are made of, and some that break them.
+const PIECES: &[&str] = &[
+    "(",
+    ")",
+    "[",
+    "]",
+    "{",
+    "}",
+    ",",
+    ";",
+    "=",
+    "-",
+    "+",
+    "*",
+    "/",
+    ".",
+    "0",
+    "1",
+    "-1",
+    "1e400",
+    "-1e12",
+    "nan",
+    "inf",
+    "b",
+    "r",
+    "h",
+    "union()",
+    "difference()",
+    "intersection()",
+    "translate([",
+    "rotate([",
+    "scale([",
+    "cube(",
+    "sphere(r = ",
+    "cylinder(h = ",
+    "center = true",
+    "//",
+    "/*",
+    "\n",
+    "#",
+    ".",
+    "x",
+    "é",
+    "\u{0}",
+];
+
+/// `text` with `edits` applied: (position, what, piece) — delete a run,
+/// insert a piece, or repeat a run.
+fn edit_text(text: &str, edits: &[(prop::sample::Index, usize, usize)]) -> String {
+    let mut chars: Vec<char> = text.chars().collect();
+    for (at, what, piece) in edits {
+        let i = at.index(chars.len() + 1);
+        match what % 3 {
+            0 => {
+                let end = (i + piece % 12).min(chars.len());
+                chars.drain(i..end);
+            }
+            1 => {
+                let p: Vec<char> = PIECES[piece % PIECES.len()].chars().collect();
+                chars.splice(i..i, p);
+            }
+            _ => {
+                let end = (i + piece % 40).min(chars.len());
+                let run: Vec<char> = chars[i..end].to_vec();
+                chars.splice(i..i, run);
+            }
+        }
+    }
+    chars.into_iter().collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// The CSG parser and the solid it builds: an edited sandcastle is
+    /// refused or gives a solid whose bounds and membership can be asked.
+    #[test]
+    fn edited_csg_files_are_refused_or_parsed_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+    ) {
+        use reconfcheck::algorithms::scaffold::csg::CsgShape;
+        use reconfcheck::algorithms::scaffold::shape::{Shape as _, Skew};
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(root.join("models/shapes/sandcastle.csg")).unwrap();
+        let edited = edit_text(&text, &edits);
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            CsgShape::parse("edited", &edited).map(|s| {
+                let (lo, hi) = s.skew_bounds();
+                let mid = |a: i32, b: i32| ((a as i64 + b as i64) / 2) as i32;
+                s.contains(Skew::new(mid(lo.x, hi.x), mid(lo.y, hi.y), mid(lo.z, hi.z)))
+            })
+        }));
+        prop_assert!(outcome.is_ok(), "panicked on {edited:?}");
+    }
+
+    /// The 2D grid files of seed 003: an edited U-shape is refused with its
+    /// file named, or is a valid shape.
+    #[test]
+    fn edited_grid_files_are_refused_or_parsed_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+    ) {
+        use reconfcheck::algorithms::active_subtraction::Shape;
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(root.join("models/shapes2d/u-shape.txt")).unwrap();
+        let edited = edit_text(&text, &edits);
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            Shape::parse(&edited, Path::new("edited.txt")).and_then(|s| {
+                s.validate().map_err(reconfcheck::InputError::new)?;
+                Ok(s.included_count())
+            })
+        }));
+        match outcome {
+            Ok(Ok(_)) => {}
+            Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.txt") || e.file.is_none(), "{e}"),
+            Err(_) => prop_assert!(false, "panicked on {edited:?}"),
         }
     }
 }
