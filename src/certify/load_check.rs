@@ -198,6 +198,10 @@ impl StepCheck for LoadCheck {
             self.incremental,
         )))
     }
+
+    fn ranged(&self) -> bool {
+        true
+    }
 }
 
 /// Replays `schedule` and analyses every intermediate structure (and the

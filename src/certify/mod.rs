@@ -131,6 +131,11 @@ pub trait StepCheck: Send + Sync {
     fn for_range(&self) -> Option<Box<dyn StepCheck>> {
         None
     }
+    /// Whether [`StepCheck::for_range`] makes instances: asked when the
+    /// checks are split, so that no instance is built just to find out.
+    fn ranged(&self) -> bool {
+        false
+    }
 }
 
 /// Steps per range for `steps` steps: about four ranges per thread (the
@@ -217,7 +222,7 @@ pub fn certify_with(
     let (ranged, inline): (Vec<&dyn StepCheck>, Vec<&dyn StepCheck>) = checks
         .iter()
         .copied()
-        .partition(|c| range > 0 && c.for_range().is_some());
+        .partition(|c| range > 0 && c.ranged());
     // The scene at the first step of every range, taken in the one pass.
     let mut starts: Vec<(usize, World)> = Vec::new();
     let mut report = Report {
@@ -354,8 +359,10 @@ fn ranges_in_parallel(
         .par_iter()
         .filter(|(first, _)| *first < last)
         .map(|(first, start)| {
-            let checks: Vec<Box<dyn StepCheck>> =
-                ranged.iter().filter_map(|c| c.for_range()).collect();
+            let checks: Vec<Box<dyn StepCheck>> = ranged
+                .iter()
+                .map(|c| c.for_range().expect("a ranged check makes range instances"))
+                .collect();
             let mut world = start.clone();
             let mut found = Vec::new();
             for k in *first..(first + range).min(last) {
@@ -392,4 +399,102 @@ pub(crate) fn step_bar(steps: usize, template: &str) -> indicatif::ProgressBar {
     let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
     bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algorithms::random_walk::{WalkParams, walk};
+    use std::sync::{Arc, Mutex};
+
+    /// Records, per instance, the steps it checked: the prototype's own
+    /// list and one list per range instance.
+    struct Recorder {
+        ranged: bool,
+        seen: Arc<Mutex<Vec<Vec<usize>>>>,
+        mine: usize,
+    }
+
+    impl Recorder {
+        fn new(ranged: bool) -> Recorder {
+            Recorder {
+                ranged,
+                seen: Arc::new(Mutex::new(vec![Vec::new()])),
+                mine: 0,
+            }
+        }
+    }
+
+    impl StepCheck for Recorder {
+        fn name(&self) -> &'static str {
+            "recorder"
+        }
+        fn check(&self, ctx: &StepContext<'_>, out: &mut StepOutcome) {
+            self.seen.lock().unwrap()[self.mine].push(ctx.plan.step);
+            out.metrics.insert("seen".into(), 1.0);
+        }
+        fn for_range(&self) -> Option<Box<dyn StepCheck>> {
+            let mut seen = self.seen.lock().unwrap();
+            seen.push(Vec::new());
+            Some(Box::new(Recorder {
+                ranged: self.ranged,
+                seen: self.seen.clone(),
+                mine: seen.len() - 1,
+            }))
+        }
+        fn ranged(&self) -> bool {
+            self.ranged
+        }
+    }
+
+    fn schedule() -> Schedule {
+        let p = WalkParams {
+            width: 5,
+            depth: 5,
+            walkers: 4,
+            steps: 40,
+            activity: 0.7,
+            seed: 3,
+            geometric: false,
+        };
+        walk(&p, &|_, _, _| true)
+    }
+
+    #[test]
+    fn a_ranged_check_sees_every_step_once_through_one_instance_per_range() {
+        let s = schedule();
+        let rec = Recorder::new(true);
+        let opts = Options {
+            range_steps: Some(7),
+            ..Options::lattice_only()
+        };
+        let r = certify_with(&s, &opts, &[&LatticeCheck, &rec]).unwrap();
+        let seen = rec.seen.lock().unwrap();
+        assert!(seen[0].is_empty(), "the prototype checks no step itself");
+        // Instances are made as rayon reaches the ranges: order them.
+        let mut ranges = seen[1..].to_vec();
+        ranges.sort_by_key(|r| r.first().copied());
+        assert_eq!(ranges.len(), s.steps.len().div_ceil(7));
+        for (k, steps) in ranges.iter().enumerate() {
+            let first = 7 * k + 1;
+            let want: Vec<usize> = (first..(first + 7).min(s.steps.len() + 1)).collect();
+            assert_eq!(*steps, want, "range {k}: one instance, its steps in order");
+        }
+        // Every step's findings are merged back into its own result.
+        assert!(r.per_step.iter().all(|p| p.metrics["seen"] == 1.0));
+    }
+
+    #[test]
+    fn a_check_that_is_not_ranged_runs_in_the_one_pass() {
+        let s = schedule();
+        let rec = Recorder::new(false);
+        let opts = Options {
+            range_steps: Some(7),
+            ..Options::lattice_only()
+        };
+        certify_with(&s, &opts, &[&LatticeCheck, &rec]).unwrap();
+        let seen = rec.seen.lock().unwrap();
+        assert_eq!(seen.len(), 1, "no range instance was made");
+        assert_eq!(seen[0], (1..=s.steps.len()).collect::<Vec<_>>());
+    }
 }
