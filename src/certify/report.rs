@@ -197,8 +197,22 @@ impl Report {
         }
         if !self.warnings.is_empty() {
             let _ = writeln!(s, "warnings: {}", self.warnings.len());
+            let mut by_kind: BTreeMap<ViolationKind, usize> = BTreeMap::new();
+            for w in &self.warnings {
+                *by_kind.entry(w.kind).or_insert(0) += 1;
+            }
+            for (k, n) in by_kind {
+                let _ = writeln!(s, "  {n:>6} × {}", k.name());
+            }
             for w in self.warnings.iter().take(5) {
                 let _ = writeln!(s, "  step {}: {}: {}", w.step, w.kind.name(), w.message);
+            }
+            if self.warnings.len() > 5 {
+                let _ = writeln!(
+                    s,
+                    "  … {} more warnings in the JSON report",
+                    self.warnings.len() - 5
+                );
             }
         }
         let mut metrics: BTreeMap<&str, (f64, usize)> = BTreeMap::new();
@@ -214,5 +228,48 @@ impl Report {
             let _ = writeln!(s, "highest {k} over the steps: {v:.4} (step {step})");
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(violations: Vec<Violation>, warnings: Vec<Violation>) -> Report {
+        Report {
+            format: REPORT_FORMAT.into(),
+            version: 1,
+            schedule: "s.json".into(),
+            lattice: LatticeKind::Fcc,
+            modules: 3,
+            steps: 9,
+            moves: 9,
+            checks: vec!["lattice".into()],
+            certified: violations.is_empty(),
+            stopped_at: None,
+            violations,
+            warnings,
+            per_step: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_summary_counts_findings_by_kind_and_lists_the_first() {
+        let slide = |k| Violation::new(ViolationKind::SlidingContact, k, format!("slide {k}"));
+        let warnings: Vec<Violation> = (1..=7).map(slide).collect();
+        let collision = Violation::new(ViolationKind::Collision, 4, "bump");
+        let text = report(vec![collision], warnings).summary();
+        assert!(text.starts_with("NOT CERTIFIED: s.json"), "{text}");
+        assert!(text.contains("       1 × collision"), "{text}");
+        assert!(
+            text.contains("warnings: 7\n       7 × sliding_contact"),
+            "{text}"
+        );
+        assert!(text.contains("step 5: sliding_contact: slide 5"), "{text}");
+        assert!(!text.contains("slide 6"), "{text}");
+        assert!(
+            text.contains("… 2 more warnings in the JSON report"),
+            "{text}"
+        );
     }
 }
