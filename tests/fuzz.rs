@@ -220,6 +220,12 @@ fn edit_text(text: &str, edits: &[(prop::sample::Index, usize, usize)]) -> Strin
     chars.into_iter().collect()
 }
 
+/// The bundled file at `path` (from the repository root), edited.
+fn edited_model(path: &str, edits: &[(prop::sample::Index, usize, usize)]) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    edit_text(&std::fs::read_to_string(root.join(path)).unwrap(), edits)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
@@ -231,9 +237,7 @@ proptest! {
     ) {
         use reconfcheck::algorithms::scaffold::csg::CsgShape;
         use reconfcheck::algorithms::scaffold::shape::{Shape as _, Skew};
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let text = std::fs::read_to_string(root.join("models/shapes/sandcastle.csg")).unwrap();
-        let edited = edit_text(&text, &edits);
+        let edited = edited_model("models/shapes/sandcastle.csg", &edits);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             CsgShape::parse("edited", &edited).map(|s| {
                 let (lo, hi) = s.skew_bounds();
@@ -251,9 +255,7 @@ proptest! {
         edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
     ) {
         use reconfcheck::algorithms::active_subtraction::Shape;
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let text = std::fs::read_to_string(root.join("models/shapes2d/u-shape.txt")).unwrap();
-        let edited = edit_text(&text, &edits);
+        let edited = edited_model("models/shapes2d/u-shape.txt", &edits);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             Shape::parse(&edited, Path::new("edited.txt")).and_then(|s| {
                 s.validate().map_err(reconfcheck::InputError::new)?;

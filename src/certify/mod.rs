@@ -460,15 +460,20 @@ mod tests {
         walk(&p, &|_, _, _| true)
     }
 
-    #[test]
-    fn a_ranged_check_sees_every_step_once_through_one_instance_per_range() {
-        let s = schedule();
-        let rec = Recorder::new(true);
+    /// Certifies `s` with the lattice check and `rec`, ranges of 7 steps.
+    fn in_ranges_of_7(s: &Schedule, rec: &Recorder) -> Report {
         let opts = Options {
             range_steps: Some(7),
             ..Options::lattice_only()
         };
-        let r = certify_with(&s, &opts, &[&LatticeCheck, &rec]).unwrap();
+        certify_with(s, &opts, &[&LatticeCheck, rec]).unwrap()
+    }
+
+    #[test]
+    fn a_ranged_check_sees_every_step_once_through_one_instance_per_range() {
+        let s = schedule();
+        let rec = Recorder::new(true);
+        let r = in_ranges_of_7(&s, &rec);
         let seen = rec.seen.lock().unwrap();
         assert!(seen[0].is_empty(), "the prototype checks no step itself");
         // Instances are made as rayon reaches the ranges: order them.
@@ -488,11 +493,7 @@ mod tests {
     fn a_check_that_is_not_ranged_runs_in_the_one_pass() {
         let s = schedule();
         let rec = Recorder::new(false);
-        let opts = Options {
-            range_steps: Some(7),
-            ..Options::lattice_only()
-        };
-        certify_with(&s, &opts, &[&LatticeCheck, &rec]).unwrap();
+        in_ranges_of_7(&s, &rec);
         let seen = rec.seen.lock().unwrap();
         assert_eq!(seen.len(), 1, "no range instance was made");
         assert_eq!(seen[0], (1..=s.steps.len()).collect::<Vec<_>>());
