@@ -178,6 +178,45 @@ fn a_cell_beyond_the_coordinate_range_is_unusable_input() {
 }
 
 #[test]
+fn a_spacing_that_is_not_a_positive_length_is_unusable_input() {
+    for (name, value) in [("zero.json", 0.0), ("negative.json", -3.6)] {
+        let mut s = walk();
+        s["spacing"]["value"] = json!(value);
+        assert_input_error(name, &s.to_string(), &["spacing", "not a positive length"]);
+    }
+}
+
+#[test]
+fn scenario_parameters_out_of_range_are_refused_with_their_values() {
+    // activity = -5 made the random-walk generator panic.
+    let cases = [
+        (
+            "walk-activity.toml",
+            "algorithm = \"random-walk\"\n[parameters]\nwidth = 5\ndepth = 5\nwalkers = 2\nsteps = 3\nactivity = -5.0\n",
+            "activity is a probability in [0, 1], got -5",
+        ),
+        (
+            "walk-size.toml",
+            "algorithm = \"random-walk\"\n[parameters]\nwidth = 2147483647\ndepth = 3\nwalkers = 1\nsteps = 1\n",
+            "got 2147483647 × 3",
+        ),
+        (
+            "branch-spacing.toml",
+            "algorithm = \"branch\"\n[parameters]\nlength = 3\nspacing_mm = -1.0\n",
+            "spacing_mm must be a positive length, got -1",
+        ),
+    ];
+    for (name, body, needle) in cases {
+        let p = write(name, &format!("name = \"x\"\n{body}"));
+        let o = bin().arg("run").arg(&p).output().unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(name) && err.contains(needle), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
 fn a_move_to_a_non_neighbour_cell_is_unusable_input() {
     let mut s = walk();
     s["steps"][1]["events"][0]["to"] = json!([4, 0, 1]);

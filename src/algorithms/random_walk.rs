@@ -98,6 +98,11 @@ pub fn random_pivot_and_targets(
     Some((pivot, targets))
 }
 
+/// Largest platform side (cells) and number of steps a scenario may ask
+/// for: a synthetic workload far larger than any seed's.
+pub const MAX_SIDE: i32 = 1024;
+pub const MAX_STEPS: usize = 1_000_000;
+
 /// The random-walk generator.
 pub struct RandomWalk;
 
@@ -112,8 +117,23 @@ impl Generator for RandomWalk {
 
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
         let p: WalkParams = parameters(scenario)?;
-        if p.width < 2 || p.depth < 2 {
-            return Err(scenario.error("random-walk needs a platform of at least 2 × 2"));
+        if p.width < 2 || p.depth < 2 || p.width > MAX_SIDE || p.depth > MAX_SIDE {
+            return Err(scenario.error(format!(
+                "random-walk needs a platform of 2 × 2 to {MAX_SIDE} × {MAX_SIDE} cells, got {} × {}",
+                p.width, p.depth
+            )));
+        }
+        if p.steps > MAX_STEPS {
+            return Err(scenario.error(format!(
+                "random-walk makes at most {MAX_STEPS} steps, got {}",
+                p.steps
+            )));
+        }
+        if !(0.0..=1.0).contains(&p.activity) {
+            return Err(scenario.error(format!(
+                "activity is a probability in [0, 1], got {}",
+                p.activity
+            )));
         }
         if p.walkers > ((p.width - 1) * (p.depth - 1)) as usize {
             return Err(scenario.error(format!(

@@ -75,6 +75,7 @@ impl World {
     /// ids, two modules in one cell, cells that are not on the lattice or
     /// inside the ground.
     pub fn initial(s: &Schedule) -> Result<World, InputError> {
+        s.validate()?;
         let lattice = s.lattice.lattice();
         let mut world = World {
             lattice,

@@ -159,8 +159,7 @@ impl Schedule {
     pub fn from_json(text: &str, origin: &Path) -> Result<Schedule, InputError> {
         let schedule: Schedule = serde_json::from_str(text)
             .map_err(|e| InputError::new(format!("not a valid schedule: {e}")).in_file(origin))?;
-        schedule.check_header().map_err(|e| e.in_file(origin))?;
-        schedule.check_extent().map_err(|e| e.in_file(origin))?;
+        schedule.validate().map_err(|e| e.in_file(origin))?;
         Ok(schedule)
     }
 
@@ -174,6 +173,22 @@ impl Schedule {
     /// Writes the schedule as JSON (compact: schedules get large).
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).expect("schedules serialise")
+    }
+
+    /// What a schedule must satisfy before it is replayed, whether read
+    /// from a file or made by a generator: the format and version, a
+    /// positive finite spacing, and cells within [`MAX_COORDINATE`].
+    pub fn validate(&self) -> Result<(), InputError> {
+        self.check_header()?;
+        let d = self.spacing.metres();
+        if !(d.is_finite() && d > 0.0) {
+            return Err(InputError::new(format!(
+                "spacing {} {} is not a positive length",
+                self.spacing.value,
+                self.spacing.unit.name()
+            )));
+        }
+        self.check_extent()
     }
 
     /// Refuses cells and ground layers beyond [`MAX_COORDINATE`], naming

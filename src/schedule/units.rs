@@ -17,6 +17,16 @@ pub enum Unit {
 }
 
 impl Unit {
+    /// The unit as schedules write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Metre => "m",
+            Unit::Centimetre => "cm",
+            Unit::Millimetre => "mm",
+            Unit::Micrometre => "um",
+        }
+    }
+
     pub fn in_metres(self) -> f64 {
         match self {
             Unit::Metre => 1.0,
