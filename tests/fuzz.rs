@@ -4,7 +4,8 @@
 //! naming the file or certified with a verdict — through every check,
 //! collision sweeps and mechanics included. The same for the shape files:
 //! character-level edits of a CSG file and of a 2D grid file are refused or
-//! parsed. `PROPTEST_CASES=20000 cargo test --test fuzz` searches longer.
+//! parsed; and for the scenarios: each generator's parameters, edited, are
+//! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test fuzz` searches longer.
 
 use proptest::prelude::*;
 use reconfcheck::algorithms::random_walk::{WalkParams, walk};
@@ -266,6 +267,116 @@ proptest! {
             Ok(Ok(_)) => {}
             Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.txt") || e.file.is_none(), "{e}"),
             Err(_) => prop_assert!(false, "panicked on {edited:?}"),
+        }
+    }
+}
+
+/// Small valid scenarios of every parameterised generator.
+fn scenario_bases() -> Vec<(&'static str, &'static str)> {
+    vec![
+        (
+            "random-walk",
+            "width = 4\ndepth = 4\nwalkers = 2\nsteps = 3\nactivity = 0.5\nseed = 1\ngeometric = false",
+        ),
+        ("branch", "length = 3\nspacing_mm = 3.6"),
+        ("scaffold", "shape = \"pyramid\"\nh = 1\nb = 4"),
+        ("scaffold", "shape = \"cube\"\nh = 1\ne = 2\nb = 4"),
+        (
+            "active-subtraction",
+            "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
+        ),
+        (
+            "active-subtraction",
+            "mode = \"sas\"\n[random]\nwidth = 4\nheight = 4\ndensity = 0.5\nseed = 2\ngrowth = \"chain\"",
+        ),
+    ]
+}
+
+/// Parameter values that break assumptions (none large enough to be a
+/// legitimately long run).
+fn parameter_values() -> Vec<toml::Value> {
+    use toml::Value as V;
+    vec![
+        V::Integer(-1),
+        V::Integer(0),
+        V::Integer(1),
+        V::Integer(2),
+        V::Integer(3),
+        V::Integer(2147483647),
+        V::Integer(-2147483648),
+        V::Integer(4294967296),
+        V::Integer(i64::MAX),
+        V::Float(-1.5),
+        V::Float(0.0),
+        V::Float(0.5),
+        V::Float(1.0),
+        V::Float(f64::NAN),
+        V::Float(f64::INFINITY),
+        V::Float(1e300),
+        V::String("x".into()),
+        V::String("../../nowhere.txt".into()),
+        V::Boolean(true),
+        V::Array(vec![V::Integer(1)]),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Every generator with an edited parameter (a value replaced by one of
+    /// another kind or an extreme one, or deleted): refused as input naming
+    /// the scenario or a file, or generated and certified; never a panic.
+    #[test]
+    fn edited_scenario_parameters_are_refused_or_run_never_a_panic(
+        base in 0usize..6,
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..21), 1..3),
+    ) {
+        use reconfcheck::scenario::Scenario;
+        let (algorithm, text) = scenario_bases()[base];
+        let mut parameters: toml::Table = toml::from_str(text).unwrap();
+        for (pick, with) in &edits {
+            // The keys of the table and of its nested `random` table.
+            let mut keys: Vec<(Option<String>, String)> =
+                parameters.keys().map(|k| (None, k.clone())).collect();
+            if let Some(toml::Value::Table(r)) = parameters.get("random") {
+                keys.extend(r.keys().map(|k| (Some("random".to_string()), k.clone())));
+            }
+            let (outer, key) = pick.get(&keys).clone();
+            let table = match &outer {
+                Some(o) => match parameters.get_mut(o) {
+                    Some(toml::Value::Table(t)) => t,
+                    _ => continue,
+                },
+                None => &mut parameters,
+            };
+            match parameter_values().get(*with) {
+                Some(v) => {
+                    table.insert(key, v.clone());
+                }
+                None => {
+                    table.remove(&key);
+                }
+            }
+        }
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let path = root.join("scenarios/edited.toml");
+        let scenario = Scenario {
+            name: "edited".into(),
+            description: String::new(),
+            algorithm: algorithm.into(),
+            model: None,
+            parameters: parameters.clone(),
+            dir: root.join("scenarios"),
+            path: path.clone(),
+        };
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            let s = reconfcheck::algorithms::generate(&scenario)?;
+            certify(&s, &Options::lattice_only()).map(|r| r.certified)
+        }));
+        match outcome {
+            Ok(Ok(_)) => {}
+            Ok(Err(e)) => prop_assert!(e.file.is_some() || e.step.is_some(), "{algorithm} {parameters:?}: {e} names nothing"),
+            Err(_) => prop_assert!(false, "{algorithm} panicked on {parameters:?}"),
         }
     }
 }
