@@ -230,6 +230,15 @@ fn invalid_desired_configurations_are_input_errors_naming_the_file() {
         let text = e.to_string();
         assert!(text.contains(file) && text.contains(msg), "{text}");
     }
+    // A rectangle too small (or too large) for the shape is the scenario's
+    // mistake: the error names the scenario and quotes the shape file.
+    let sc = write(
+        "small.toml",
+        "name = \"x\"\nalgorithm = \"active-subtraction\"\n[parameters]\nmode = \"sas\"\nshape = \"ok.txt\"\nwidth = 1\n",
+    );
+    let e = algorithms::generate(&Scenario::load(&sc).unwrap()).unwrap_err();
+    assert_eq!(e.file.as_deref(), Some(sc.as_path()), "{e}");
+    assert!(e.message.contains("ok.txt"), "{e}");
     let sc = write(
         "bad.toml",
         "name = \"x\"\nalgorithm = \"active-subtraction\"\n[parameters]\nmode = \"fast\"\nshape = \"ok.txt\"\n",

@@ -150,8 +150,10 @@ impl Generator for ActiveSubtraction {
                 let path = scenario.resolve(file);
                 let s = Shape::load(&path)?;
                 let (w, h) = (p.width.unwrap_or(s.width), p.height.unwrap_or(s.height));
+                // The rectangle comes from the scenario, the shape from its
+                // file: the error names the scenario and quotes the file.
                 s.within(w, h)
-                    .map_err(|m| InputError::new(m).in_file(&path))?
+                    .map_err(|m| scenario.error(format!("{m} (shape {})", path.display())))?
             }
             (None, Some(r)) => {
                 if p.width.is_some() || p.height.is_some() {
