@@ -17,7 +17,8 @@
 //! * [`study`] — questions asked over many schedules (the b-study, load
 //!   maps, synthetic benchmarks).
 //!
-//! [`render`] (SVG → PNG) is a leaf that any layer may draw with.
+//! [`render`] (SVG → PNG) and [`progress`] (progress bars) are leaves that
+//! any layer may use.
 
 pub mod algorithms;
 pub mod certify;
@@ -25,6 +26,7 @@ pub mod error;
 pub mod geometry;
 pub mod lattice;
 pub mod mechanics;
+pub mod progress;
 pub mod render;
 pub mod scenario;
 pub mod schedule;

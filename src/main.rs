@@ -336,13 +336,24 @@ fn run(cmd: Command) -> Result<u8, Failure> {
                     "density-study needs samples ≥ 1, sizes ≥ 2 and densities in 1..99 %".into(),
                 ));
             }
-            let samples = study::run(&cfg).map_err(bad)?;
+            // One bar over every sample: the study, then its repeats.
+            let total = study::sample_count(&cfg) * (1 + repeats.filter(|&n| n >= 2).unwrap_or(0));
+            let bar = if std::io::stderr().is_terminal() {
+                reconfcheck::progress::bar(
+                    total,
+                    "density study {bar:40} {pos}/{len} samples ({per_sec}, eta {eta})",
+                )
+            } else {
+                indicatif::ProgressBar::hidden()
+            };
+            let samples = study::run_observed(&cfg, &bar).map_err(bad)?;
             let rows = study::summarise(&cfg, &samples);
-            print!("{}", study::table(&rows));
             let spread = match repeats.filter(|&n| n >= 2) {
-                Some(n) => study::spread(&cfg, n).map_err(bad)?,
+                Some(n) => study::spread_observed(&cfg, n, &bar).map_err(bad)?,
                 None => Vec::new(),
             };
+            bar.finish_and_clear();
+            print!("{}", study::table(&rows));
             if let Some(n) = repeats.filter(|&n| n >= 2) {
                 print!("\n{}", study::spread_table(&spread, n));
             }

@@ -463,8 +463,15 @@ fn density_study_spread_summarises_the_medians_of_repeated_studies() {
         seed: 7,
         growth: Growth::Member,
     };
-    let spread = study::spread(&cfg, 3).unwrap();
+    let bar = indicatif::ProgressBar::hidden();
+    let spread = study::spread_observed(&cfg, 3, &bar).unwrap();
     assert_eq!(spread.len(), 3);
+    assert_eq!(
+        bar.position() as usize,
+        3 * study::sample_count(&cfg),
+        "progress counts every sample of every study"
+    );
+    assert_eq!(spread, study::spread(&cfg, 3).unwrap());
     // The same medians, one study at a time.
     let medians: Vec<Vec<f64>> = (7..10)
         .map(|seed| {

@@ -386,19 +386,10 @@ fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {
     if !opts.progress || steps < 50 {
         return indicatif::ProgressBar::hidden();
     }
-    step_bar(
+    crate::progress::bar(
         steps,
         "certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})",
     )
-}
-
-/// A progress bar over `steps` steps on stderr, drawn with `template`
-/// (indicatif's syntax); shared by certification and the studies.
-pub(crate) fn step_bar(steps: usize, template: &str) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    let bar = ProgressBar::with_draw_target(Some(steps as u64), ProgressDrawTarget::stderr());
-    bar.set_style(ProgressStyle::with_template(template).expect("valid template"));
-    bar
 }
 
 #[cfg(test)]

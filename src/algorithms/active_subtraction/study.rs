@@ -7,6 +7,7 @@ use super::pas::{self, PasTimes};
 use super::random::{Growth, random_shape_grown};
 use super::sas;
 use crate::render::{SvgCanvas, save};
+use indicatif::ProgressBar;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -95,6 +96,16 @@ fn sample_seed(base: u64, size: i32, density: u32, k: usize) -> u64 {
 
 /// Runs the study (in parallel over samples). Deterministic for a config.
 pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
+    run_observed(cfg, &ProgressBar::hidden())
+}
+
+/// Samples one study draws: sizes × densities × samples.
+pub fn sample_count(cfg: &StudyConfig) -> usize {
+    cfg.sizes.len() * cfg.densities.len() * cfg.samples
+}
+
+/// [`run`], advancing `bar` by one per sample.
+pub fn run_observed(cfg: &StudyConfig, bar: &ProgressBar) -> Result<Vec<Sample>, String> {
     let jobs: Vec<(i32, u32, usize)> = cfg
         .sizes
         .iter()
@@ -113,6 +124,7 @@ pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
             let sas_t = PasTimes::sequential(&run).time_steps() as f64;
             let pas_t = pas::plan(&shape, &run)?.time_steps() as f64;
             let best = sas::best_case_time(&shape) as f64 / n;
+            bar.inc(1);
             Ok(Sample {
                 size,
                 density,
@@ -214,13 +226,22 @@ fn spread_len(spread: &[Spread]) -> usize {
 
 /// Runs `repeats` studies (see [`Spread`]).
 pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> {
+    spread_observed(cfg, repeats, &ProgressBar::hidden())
+}
+
+/// [`spread`], advancing `bar` by one per sample of every study.
+pub fn spread_observed(
+    cfg: &StudyConfig,
+    repeats: usize,
+    bar: &ProgressBar,
+) -> Result<Vec<Spread>, String> {
     let mut medians: Vec<Vec<Row>> = Vec::new();
     for r in 0..repeats as u64 {
         let c = StudyConfig {
             seed: cfg.seed.wrapping_add(r),
             ..cfg.clone()
         };
-        medians.push(summarise(&c, &run(&c)?));
+        medians.push(summarise(&c, &run_observed(&c, bar)?));
     }
     let stats = |v: &[f64]| {
         let n = v.len() as f64;
