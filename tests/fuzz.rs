@@ -341,6 +341,9 @@ proptest! {
             if let Some(toml::Value::Table(r)) = parameters.get("random") {
                 keys.extend(r.keys().map(|k| (Some("random".to_string()), k.clone())));
             }
+            if keys.is_empty() {
+                break;
+            }
             let (outer, key) = pick.get(&keys).clone();
             let table = match &outer {
                 Some(o) => match parameters.get_mut(o) {
