@@ -203,16 +203,25 @@ fn scenario_parameters_out_of_range_are_refused_with_their_values() {
         (
             "branch-spacing.toml",
             "algorithm = \"branch\"\n[parameters]\nlength = 3\nspacing_mm = -1.0\n",
-            "spacing_mm must be a positive length, got -1",
+            "spacing -1 mm is not a positive length",
         ),
     ];
     for (name, body, needle) in cases {
         let p = write(name, &format!("name = \"x\"\n{body}"));
-        let o = bin().arg("run").arg(&p).output().unwrap();
-        let err = stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
-        assert!(err.contains(name) && err.contains(needle), "{name}: {err}");
-        assert!(!err.contains("panicked"), "{err}");
+        // `generate` refuses what `run` refuses: no schedule is written
+        // that `certify` would not read.
+        for command in ["run", "generate"] {
+            let o = bin()
+                .arg(command)
+                .arg(&p)
+                .args(["-o", scratch("refused.json").to_str().unwrap()])
+                .output()
+                .unwrap();
+            let err = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{command} {name}: {err}");
+            assert!(err.contains(name) && err.contains(needle), "{name}: {err}");
+            assert!(!err.contains("panicked"), "{err}");
+        }
     }
 }
 

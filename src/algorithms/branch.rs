@@ -44,11 +44,6 @@ pub fn branch_schedule(b: usize, spacing_mm: f64) -> Result<Schedule, InputError
             "branch length must be in 1..={MAX_LENGTH}, got {b}"
         )));
     }
-    if !(spacing_mm.is_finite() && spacing_mm > 0.0) {
-        return Err(InputError::new(format!(
-            "spacing_mm must be a positive length, got {spacing_mm}"
-        )));
-    }
     let l = FccLattice;
     let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(spacing_mm));
     s.modules.push(ModuleSpec {

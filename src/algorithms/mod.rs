@@ -46,10 +46,14 @@ pub fn find(name: &str) -> Result<&'static dyn Generator, String> {
         })
 }
 
-/// Runs the generator named by the scenario.
+/// Runs the generator named by the scenario; its schedule is validated
+/// ([`Schedule::validate`]) before it is returned.
 pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
     let g = find(&scenario.algorithm).map_err(|e| scenario.error(e))?;
     let mut s = g.generate(scenario)?;
+    // What a generator made is held to what a file is held to, so that
+    // `generate` never writes a schedule `certify` would refuse.
+    s.validate().map_err(|e| e.in_file(&scenario.path))?;
     s.meta
         .entry("scenario".into())
         .or_insert_with(|| scenario.name.clone().into());
