@@ -338,14 +338,11 @@ fn run(cmd: Command) -> Result<u8, Failure> {
             }
             // One bar over every sample: the study, then its repeats.
             let total = study::sample_count(&cfg) * (1 + repeats.filter(|&n| n >= 2).unwrap_or(0));
-            let bar = if std::io::stderr().is_terminal() {
-                reconfcheck::progress::bar(
-                    total,
-                    "density study {bar:40} {pos}/{len} samples ({per_sec}, eta {eta})",
-                )
-            } else {
-                indicatif::ProgressBar::hidden()
-            };
+            let bar = reconfcheck::progress::bar(
+                std::io::stderr().is_terminal(),
+                total,
+                "density study {bar:40} {pos}/{len} samples ({per_sec}, eta {eta})",
+            );
             let samples = study::run_observed(&cfg, &bar).map_err(bad)?;
             let rows = study::summarise(&cfg, &samples);
             let spread = match repeats.filter(|&n| n >= 2) {

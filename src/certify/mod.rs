@@ -383,10 +383,8 @@ fn ranges_in_parallel(
 }
 
 fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {
-    if !opts.progress || steps < 50 {
-        return indicatif::ProgressBar::hidden();
-    }
     crate::progress::bar(
+        opts.progress && steps >= 50,
         steps,
         "certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})",
     )

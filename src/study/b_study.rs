@@ -181,10 +181,11 @@ pub fn default_range(name: &str) -> (usize, usize) {
 }
 
 fn progress_bar(on: bool, b: usize, steps: usize) -> indicatif::ProgressBar {
-    if !on {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = crate::progress::bar(steps, "b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})");
+    let bar = crate::progress::bar(
+        on,
+        steps,
+        "b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})",
+    );
     bar.set_message(b.to_string());
     bar
 }
