@@ -479,6 +479,21 @@ mod tests {
     }
 
     #[test]
+    fn a_schedule_built_in_code_is_validated_before_replay() {
+        // Not read from a file, not made by `algorithms::generate`: the
+        // replay itself refuses what a file would be refused for.
+        let mut s = schedule();
+        s.spacing.value = -3.6;
+        let e = certify(&s, &Options::lattice_only()).unwrap_err();
+        assert!(e.message.contains("not a positive length"), "{e}");
+        let mut s = schedule();
+        s.modules[0].cell = crate::lattice::Cell::new(i32::MIN, 0, 0);
+        let e = certify(&s, &Options::lattice_only()).unwrap_err();
+        assert!(e.message.contains("beyond"), "{e}");
+        assert_eq!(e.module, Some(s.modules[0].id));
+    }
+
+    #[test]
     fn a_check_that_is_not_ranged_runs_in_the_one_pass() {
         let s = schedule();
         let rec = Recorder::new(false);
