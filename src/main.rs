@@ -3,6 +3,8 @@
 //! Exit codes: 0 certified, 1 violations found, 2 unusable input,
 //! 3 an output file could not be written.
 
+mod cli;
+
 use clap::{Parser, Subcommand};
 use reconfcheck::algorithms;
 use reconfcheck::certify::{self, Options, Report};

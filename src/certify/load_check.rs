@@ -74,11 +74,11 @@ pub fn critical_violation(
     let overloaded = a
         .links
         .iter()
-        .filter(|r| r.utilisation > 1.0 + 1e-9)
+        .filter(|r| crate::mechanics::capacity::overloaded(r.utilisation))
         .count()
         + a.pivots
             .iter()
-            .filter(|r| r.utilisation > 1.0 + 1e-9)
+            .filter(|r| crate::mechanics::capacity::overloaded(r.utilisation))
             .count();
     let mut v = match a.critical {
         Some(Critical::Link(i)) => {

@@ -8,7 +8,7 @@
 //! `W = m·g`; interface stiffnesses relative to the axial one (the absolute
 //! modulus and layer thickness cancel out of the loads). Results are in SI.
 
-use super::capacity::{ConnectorLoad, Mode, utilisation};
+use super::capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};
 use super::direct::Factor;
 use super::model::{Capacity, Model};
 use super::reuse::KeptFactor;
@@ -396,7 +396,7 @@ impl Analyzer {
                     }
                     let load = self.link_forces(s, l, &q_all, sliding[li]).0;
                     let (u, mode) = utilisation(&load, &self.model.ground);
-                    if u > 1.0 + 1e-9 {
+                    if overloaded(u) {
                         match mode {
                             Mode::Bending => lift.push(li),
                             Mode::Friction if !sliding[li] => slide.push(li),
@@ -506,35 +506,37 @@ impl Analyzer {
         // Summary.
         let mut max = 0.0;
         let mut crit = None;
-        let mut overloaded = false;
+        let mut any_overloaded = false;
         let mut slides = false;
         for (i, r) in out.links.iter().enumerate() {
-            if r.utilisation > max || (crit.is_none() && r.utilisation > 0.0) {
-                max = r.utilisation;
+            let u = severity(r.utilisation);
+            if u > max || (crit.is_none() && u > 0.0) {
+                max = u;
                 crit = Some(Critical::Link(i));
             }
-            if r.utilisation > 1.0 + 1e-9 {
+            if overloaded(r.utilisation) {
                 if s.links[i].is_ground() {
                     slides = true;
                 } else {
-                    overloaded = true;
+                    any_overloaded = true;
                 }
             }
         }
         for (i, r) in out.pivots.iter().enumerate() {
-            if r.utilisation > max {
-                max = r.utilisation;
+            let u = severity(r.utilisation);
+            if u > max {
+                max = u;
                 crit = Some(Critical::Pivot(i));
             }
-            if r.utilisation > 1.0 + 1e-9 {
-                overloaded = true;
+            if overloaded(r.utilisation) {
+                any_overloaded = true;
             }
         }
         out.max_utilisation = max;
         out.critical = crit;
         out.verdict = Some(if any_unsupported || slides {
             Verdict::NoEquilibrium
-        } else if overloaded {
+        } else if any_overloaded {
             Verdict::Overloaded
         } else {
             Verdict::Stable

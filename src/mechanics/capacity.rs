@@ -28,6 +28,24 @@ use super::model::{Bending, Capacity};
 /// `L` (SPEC §7: `∫|r| dA / A` for the unit square ≈ 0.3826).
 pub const TORSION_LEVER: f64 = 0.383;
 
+/// Slack on the utilisation limit: solver round-off must not turn a load
+/// at exactly its capacity into an overload.
+pub const OVERLOAD_SLACK: f64 = 1e-9;
+
+/// Whether a utilisation exceeds its capacity. The one predicate every check
+/// judges utilisations by: a value that is not finite (NaN from a degenerate
+/// solve, an infinity from a vanished capacity) counts as overloaded, so
+/// that a number that compares false can never read as "within limits".
+pub fn overloaded(u: f64) -> bool {
+    !u.is_finite() || u > 1.0 + OVERLOAD_SLACK
+}
+
+/// Orders utilisations for "the most loaded": non-finite values rank above
+/// every finite one, so a NaN is never hidden behind a finite maximum.
+pub fn severity(u: f64) -> f64 {
+    if u.is_finite() { u } else { f64::INFINITY }
+}
+
 /// A connector's load in its own frame (N, N·m).
 #[derive(Copy, Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ConnectorLoad {

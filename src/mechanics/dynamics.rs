@@ -103,8 +103,11 @@ pub fn simulate(model: &Model, s: &Structure, duration: f64) -> Outcome {
                 .links
                 .iter()
                 .enumerate()
-                .filter(|(_, r)| r.utilisation > 1.0 + 1e-9)
-                .max_by(|x, y| x.1.utilisation.total_cmp(&y.1.utilisation))
+                .filter(|(_, r)| super::capacity::overloaded(r.utilisation))
+                .max_by(|x, y| {
+                    super::capacity::severity(x.1.utilisation)
+                        .total_cmp(&super::capacity::severity(y.1.utilisation))
+                })
                 .map(|(k, _)| intact[k]);
             let Some(li) = worst else { break };
             if let Some(h) = joints[li].take() {
@@ -156,7 +159,7 @@ mod tests {
     fn overloaded(model: &Model, s: &Structure) -> Vec<usize> {
         let a = Analyzer::new(model.clone(), false).analyse(s);
         (0..s.links.len())
-            .filter(|&i| a.links[i].utilisation > 1.0)
+            .filter(|&i| crate::mechanics::capacity::overloaded(a.links[i].utilisation))
             .collect()
     }
 

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 /// Colour of a utilisation: green (0) → yellow (½) → red (1); purple > 1.
 pub fn colour(u: f64) -> RGBColor {
-    if !u.is_finite() || u > 1.0 + 1e-9 {
+    if super::capacity::overloaded(u) {
         return RGBColor(150, 0, 200);
     }
     let u = u.clamp(0.0, 1.0);
@@ -135,7 +135,7 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
             };
             let (ax, ay, _) = proj(pa);
             let (bx, by, _) = proj(pb);
-            let width = if res.utilisation > 1.0 {
+            let width = if super::capacity::overloaded(res.utilisation) {
                 4
             } else {
                 2 + (res.utilisation * 2.0) as u32

@@ -18,7 +18,6 @@ pub mod analysis;
 pub mod capacity;
 pub mod closed_form;
 pub mod direct;
-pub mod dynamics;
 pub mod loadmap;
 pub mod model;
 pub mod reuse;
@@ -30,5 +29,9 @@ pub use capacity::{ConnectorLoad, Mode, utilisation};
 pub use model::{Bending, Model};
 pub use structure::{SceneRef, Structure};
 
+/// rapier's dynamic cross-check of the static analysis: test-only, so the
+/// library does not carry a physics engine it never runs.
+#[cfg(test)]
+mod dynamics;
 #[cfg(test)]
 mod validation;

@@ -46,7 +46,9 @@ pub struct Row {
 
 impl Row {
     pub fn safe(&self) -> bool {
-        self.lattice_violations == 0 && !self.no_equilibrium && self.max_utilisation <= 1.0 + 1e-9
+        self.lattice_violations == 0
+            && !self.no_equilibrium
+            && !crate::mechanics::capacity::overloaded(self.max_utilisation)
     }
 
     pub fn min_pressure(&self, bending: Bending) -> f64 {

@@ -1,0 +1,4 @@
+//! The binary's subcommands that have logic of their own, one module each;
+//! `main.rs` only parses arguments and dispatches here. Library code stays
+//! in the library: these modules turn flags into validated library inputs
+//! and library results into files, text and exit codes.
