@@ -55,7 +55,7 @@ fn sweep_checks(c: &mut Criterion) {
                     config: &config,
                     moves: &moves,
                     moving: &moving,
-                    epsilon: EPSILON,
+                    epsilon: reconfcheck::geometry::Tolerance::DEFAULT,
                     exact,
                 };
                 black_box(FccSweep.check_step(&input))

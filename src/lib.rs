@@ -1,24 +1,28 @@
 //! reconfcheck — certifies that a lattice modular robot's reconfiguration is
 //! physically feasible.
 //!
-//! Layers, each depending only on those above it in this list:
+//! Layers, each depending only on those before it in this list (the test
+//! `tests/architecture.rs` enforces it):
 //!
-//! * [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
-//! * [`schedule`] — the versioned schedule format shared by every seed;
-//! * [`scenario`] — runnable cases: a generator's name and its inputs;
-//! * [`geometry`] — module bodies, continuous sweeps, and the motion rules
-//!   derived from them;
-//! * [`mechanics`] — the frame model of a structure: equilibrium, connector
-//!   loads, capacities;
-//! * [`certify`] — replays a schedule and runs every check on every step;
-//! * [`algorithms`] — generators that emit schedules (depend on `lattice`,
-//!   `schedule` and `geometry`'s motion rules, never on `mechanics` or
-//!   `certify`);
-//! * [`study`] — questions asked over many schedules (the b-study, load
-//!   maps, synthetic benchmarks).
+//! 1. [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
+//! 2. [`schedule`], [`scenario`] — the versioned schedule format shared by
+//!    every seed, and runnable cases (a generator's name and its inputs);
+//! 3. [`geometry`] — module bodies, continuous sweeps, and the motion rules
+//!    derived from them;
+//! 4. [`mechanics`] — the frame model of a structure: equilibrium, connector
+//!    loads, capacities;
+//! 5. [`algorithms`] — generators that emit schedules; they plan with
+//!    `geometry`'s motion rules and never see `mechanics` or `certify`;
+//! 6. [`certify`] — replays a schedule and runs every check on every step;
+//!    it never sees the generators;
+//! 7. [`study`] — questions asked over many schedules (the b-study, the
+//!    density study, load maps, synthetic benchmarks);
+//! 8. [`render`] (feature `render`, on by default) — pictures and plots of
+//!    all of the above.
 //!
-//! [`render`] (SVG → PNG) and [`progress`] (progress bars) are leaves that
-//! any layer may use.
+//! [`error`], [`number`] and [`progress`] are leaves every layer may use:
+//! errors, validated numbers, progress reports. The library never prints,
+//! reads the environment or draws a progress bar: the binary does.
 
 pub mod algorithms;
 pub mod certify;
@@ -26,10 +30,12 @@ pub mod error;
 pub mod geometry;
 pub mod lattice;
 pub mod mechanics;
+pub mod number;
 pub mod progress;
+#[cfg(feature = "render")]
 pub mod render;
 pub mod scenario;
 pub mod schedule;
 pub mod study;
 
-pub use error::InputError;
+pub use error::{Error, InputError};

@@ -37,8 +37,7 @@ pub struct Scenario {
 
 impl Scenario {
     pub fn load(path: &Path) -> Result<Scenario, InputError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| InputError::new(format!("cannot read scenario: {e}")).in_file(path))?;
+        let text = crate::error::read_file(path, "scenario")?;
         let mut s: Scenario = toml::from_str(&text)
             .map_err(|e| InputError::new(format!("not a valid scenario: {e}")).in_file(path))?;
         s.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();

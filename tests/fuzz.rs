@@ -259,7 +259,7 @@ proptest! {
         let edited = edited_model("models/shapes2d/u-shape.txt", &edits);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             Shape::parse(&edited, Path::new("edited.txt")).and_then(|s| {
-                s.validate().map_err(reconfcheck::InputError::new)?;
+                s.validate()?;
                 Ok(s.included_count())
             })
         }));

@@ -36,20 +36,23 @@ pub fn registry() -> Vec<&'static dyn Generator> {
 }
 
 /// Finds the generator a scenario names.
-pub fn find(name: &str) -> Result<&'static dyn Generator, String> {
+pub fn find(name: &str) -> Result<&'static dyn Generator, InputError> {
     registry()
         .into_iter()
         .find(|g| g.name() == name)
         .ok_or_else(|| {
             let known: Vec<_> = registry().iter().map(|g| g.name()).collect();
-            format!("unknown algorithm '{name}' (known: {})", known.join(", "))
+            InputError::new(format!(
+                "unknown algorithm '{name}' (known: {})",
+                known.join(", ")
+            ))
         })
 }
 
 /// Runs the generator named by the scenario; its schedule is validated
 /// ([`Schedule::validate`]) before it is returned.
 pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
-    let g = find(&scenario.algorithm).map_err(|e| scenario.error(e))?;
+    let g = find(&scenario.algorithm).map_err(|e| e.in_file(&scenario.path))?;
     let mut s = g.generate(scenario)?;
     // What a generator made is held to what a file is held to, so that
     // `generate` never writes a schedule `certify` would refuse.

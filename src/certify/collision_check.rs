@@ -8,7 +8,7 @@ use crate::geometry::{Contact, ContactKind, SweepInput, SweepModel};
 /// Runs a sweep model on every step.
 pub struct CollisionCheck {
     pub model: &'static dyn SweepModel,
-    pub epsilon: f64,
+    pub epsilon: crate::geometry::Tolerance,
     pub exact: bool,
 }
 

@@ -17,6 +17,7 @@ pub use report::{Report, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;
+use crate::progress::Reporter;
 use crate::schedule::Schedule;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -26,12 +27,12 @@ use std::path::PathBuf;
 pub struct Options {
     /// Name of the schedule in the report (usually its path).
     pub name: String,
-    /// Show a progress bar on standard error for long schedules.
-    pub progress: bool,
+    /// Where to report how many steps are checked.
+    pub progress: Reporter,
     /// Force exact sweeps everywhere (no compiled rule tables).
     pub exact: bool,
-    /// Collision tolerance in units of d.
-    pub epsilon: f64,
+    /// Collision tolerance.
+    pub epsilon: crate::geometry::Tolerance,
     /// Run the lattice checks only (no geometry, no mechanics).
     pub lattice_only: bool,
     /// Physical model file for the mechanics check; overrides the
@@ -61,9 +62,9 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             name: "schedule".into(),
-            progress: false,
+            progress: Reporter::silent(),
             exact: false,
-            epsilon: crate::geometry::EPSILON,
+            epsilon: crate::geometry::Tolerance::DEFAULT,
             lattice_only: false,
             model: None,
             base_dir: None,
@@ -241,7 +242,8 @@ pub fn certify_with(
         per_step: Vec::with_capacity(schedule.steps.len()),
     };
     let passes = if ranged.is_empty() { 1 } else { 2 };
-    let bar = progress_bar(opts, passes * schedule.steps.len());
+    let bar = &opts.progress;
+    bar.start("certifying", (passes * schedule.steps.len()) as u64);
 
     // The initial configuration must stand on its own.
     let nobody = Default::default();
@@ -290,7 +292,7 @@ pub fn certify_with(
         });
         report.violations.extend(out.violations);
         report.warnings.extend(out.warnings);
-        bar.inc(1);
+        bar.advance(1);
         if stop {
             report.stopped_at = Some(index);
             break;
@@ -311,7 +313,7 @@ pub fn certify_with(
         report.violations.sort_by_key(|v| v.step);
         report.warnings.sort_by_key(|v| v.step);
     }
-    bar.finish_and_clear();
+    bar.finish();
 
     if report.stopped_at.is_none() {
         let final_step = schedule.steps.len() + 1;
@@ -352,7 +354,7 @@ fn ranges_in_parallel(
     starts: &[(usize, World)],
     range: usize,
     last: usize,
-    bar: &indicatif::ProgressBar,
+    bar: &Reporter,
 ) -> Result<Vec<(usize, StepOutcome)>, InputError> {
     use rayon::prelude::*;
     let per_range: Vec<Vec<(usize, StepOutcome)>> = starts
@@ -374,20 +376,12 @@ fn ranges_in_parallel(
                     out
                 })?;
                 found.push((k, out));
-                bar.inc(1);
+                bar.advance(1);
             }
             Ok(found)
         })
         .collect::<Result<_, InputError>>()?;
     Ok(per_range.into_iter().flatten().collect())
-}
-
-fn progress_bar(opts: &Options, steps: usize) -> indicatif::ProgressBar {
-    crate::progress::bar(
-        opts.progress && steps >= 50,
-        steps,
-        "certifying {bar:40} {pos}/{len} steps ({per_sec}, eta {eta})",
-    )
 }
 
 #[cfg(test)]

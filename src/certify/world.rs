@@ -90,7 +90,7 @@ impl World {
         };
         for m in &s.modules {
             let err = |msg: String| InputError::new(msg).at_step(0).for_module(m.id);
-            world.check_cell(m.cell).map_err(err)?;
+            world.check_cell(m.cell).map_err(|e| err(e.message))?;
             if world.config.contains(m.id) {
                 return Err(err(format!("module id {} is declared twice", m.id)));
             }
@@ -112,15 +112,19 @@ impl World {
         Ok(world)
     }
 
-    fn check_cell(&self, c: Cell) -> Result<(), String> {
-        self.lattice.check_cell(c)?;
+    /// Whether `c` may hold a module: a cell of the lattice, not inside the
+    /// ground. The message says why not.
+    fn check_cell(&self, c: Cell) -> Result<(), InputError> {
+        self.lattice
+            .check_cell(c)
+            .map_err(|e| InputError::new(e.to_string()))?;
         if let Some(g) = self.ground
             && g.is_ground_cell(self.lattice, c)
         {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "cell {c} is inside the ground (below layer {})",
                 g.layer
-            ));
+            )));
         }
         Ok(())
     }
@@ -263,7 +267,7 @@ impl World {
                         _ => unreachable!(),
                     };
                     for c in [motion.from(), motion.to()] {
-                        self.check_cell(c).map_err(err)?;
+                        self.check_cell(c).map_err(|e| err(e.message))?;
                     }
                     let pivot_resolved = pivot_id.is_none() || pivot_cell.is_some();
                     let requirements = if pivot_resolved {
@@ -288,7 +292,7 @@ impl World {
                             "module {id} enters but is already in the scene"
                         )));
                     }
-                    self.check_cell(*cell).map_err(err)?;
+                    self.check_cell(*cell).map_err(|e| err(e.message))?;
                     plan.enters.push((id, *cell));
                 }
                 Event::Leave { .. } => {

@@ -2,3 +2,11 @@
 //! `main.rs` only parses arguments and dispatches here. Library code stays
 //! in the library: these modules turn flags into validated library inputs
 //! and library results into files, text and exit codes.
+
+pub mod b_study;
+pub mod density;
+#[cfg(feature = "render")]
+pub mod pictures;
+pub mod progress;
+pub mod report;
+pub mod schedule;

@@ -101,12 +101,12 @@ impl FccSweep {
                 .filter(|o| *o != m.id && Some(*o) != m.pivot_id && !movers.contains(o))
         };
         let mut out = Vec::new();
-        if input.exact || input.epsilon != EPSILON {
+        if input.exact || table().tolerance() != input.epsilon {
             for off in offsets_within_reach() {
                 let cell = off.from(m.pivot);
                 if let Some(o) = others(cell) {
                     let centre = input.lattice.centre(cell);
-                    let sw = sweep_pair(&m.roll, &Path::Static(centre), input.epsilon);
+                    let sw = sweep_pair(&m.roll, &Path::Static(centre), input.epsilon.get());
                     out.extend(outcome_contact(sw.outcome, m.id, o));
                 }
             }
@@ -185,7 +185,7 @@ impl SweepModel for FccSweep {
 
         let pair_check = |&(i, j): &(usize, usize)| {
             let (a, b) = (&movers[i], &movers[j]);
-            let sw = sweep_pair(&a.roll, &Path::Rolling(b.roll), input.epsilon);
+            let sw = sweep_pair(&a.roll, &Path::Rolling(b.roll), input.epsilon.get());
             outcome_contact(sw.outcome, a.id, b.id)
         };
         let mut out: Vec<Contact>;
@@ -251,7 +251,7 @@ mod tests {
             config: &s.config,
             moves: &s.moves,
             moving: &s.moving,
-            epsilon: EPSILON,
+            epsilon: crate::geometry::Tolerance::DEFAULT,
             exact,
         };
         let mut v = FccSweep.check_step(&input);
@@ -431,7 +431,7 @@ mod tests {
                 config: &config,
                 moves: &moves,
                 moving: &moving,
-                epsilon: EPSILON,
+                epsilon: crate::geometry::Tolerance::DEFAULT,
                 exact,
             };
             let c = FccSweep.check_step(&input);
@@ -470,7 +470,7 @@ mod tests {
             config: &config,
             moves: &moves,
             moving: &moving,
-            epsilon: EPSILON,
+            epsilon: crate::geometry::Tolerance::DEFAULT,
             exact: true,
         };
         let c = FccSweep.check_step(&input);

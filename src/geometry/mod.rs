@@ -6,7 +6,6 @@
 
 pub mod catom;
 pub mod fcc_sweep;
-pub mod picture;
 pub mod rolling;
 pub mod rules;
 pub mod sweep;
@@ -22,6 +21,50 @@ pub mod square;
 /// Default certification tolerance, in units of the lattice spacing d.
 pub const EPSILON: f64 = 1e-6;
 
+/// The collision tolerance ε, in units of the lattice spacing d: penetration
+/// deeper than ε is a collision, contact within ±ε sliding contact.
+///
+/// Validated to (0, [`Tolerance::MAX`]]: ε ≤ 0 stalls the conservative
+/// advancement (its step (dist + ε)/v is never positive), NaN compares false
+/// and would certify anything, and a large ε turns deep penetrations into
+/// "sliding contact" warnings.
+#[derive(Copy, Clone, Debug, PartialEq, PartialOrd, Serialize)]
+pub struct Tolerance(f64);
+
+impl Tolerance {
+    /// The default, [`EPSILON`].
+    pub const DEFAULT: Tolerance = Tolerance(EPSILON);
+    /// The largest tolerance accepted: a tenth of the lattice spacing.
+    pub const MAX: f64 = 0.1;
+
+    pub fn new(eps: f64) -> Result<Tolerance, crate::number::InvalidNumber> {
+        let eps = crate::number::within(eps, 0.0, Self::MAX, "a tolerance in (0, 0.1] d")?;
+        crate::number::positive(eps)
+            .map(Tolerance)
+            .map_err(|e| crate::number::InvalidNumber {
+                expected: "a tolerance in (0, 0.1] d",
+                ..e
+            })
+    }
+
+    /// ε in units of d.
+    pub fn get(self) -> f64 {
+        self.0
+    }
+}
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Tolerance::DEFAULT
+    }
+}
+
+impl std::fmt::Display for Tolerance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
 /// One step's moves, as the sweep model sees them.
 pub struct SweepInput<'a> {
     pub lattice: &'a dyn Lattice,
@@ -31,9 +74,9 @@ pub struct SweepInput<'a> {
     pub moves: &'a [(ModuleId, Option<ModuleId>, Motion)],
     /// Modules that do not stay put during the step.
     pub moving: &'a FxHashSet<ModuleId>,
-    /// Tolerance ε in units of d: penetration deeper than ε is a collision,
-    /// contact within ±ε with a module other than the pivot is sliding contact.
-    pub epsilon: f64,
+    /// Tolerance ε: penetration deeper than ε is a collision, contact
+    /// within ±ε with a module other than the pivot is sliding contact.
+    pub epsilon: Tolerance,
     /// Force the exact sweep (no compiled rule tables).
     pub exact: bool,
 }

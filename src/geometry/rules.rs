@@ -16,7 +16,7 @@
 use super::catom::catom;
 use super::rolling::{Link, Roll, links};
 use super::sweep::{PairOutcome, Path, Sample, sweep_pair};
-use super::{ContactKind, EPSILON, MotionRules};
+use super::{ContactKind, MotionRules, Tolerance};
 use crate::lattice::{Cell, FccLattice, Lattice, Motion};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -137,6 +137,9 @@ const PINCH_COSINE: f64 = 0.99;
 /// The compiled rule table of all 120 links.
 pub struct RuleTable {
     pub links: Vec<LinkRules>,
+    /// The tolerance the table was derived with: it answers for sweeps at
+    /// this ε only.
+    tolerance: Tolerance,
     /// Index of `links` by (from, to, route).
     index: [[[u8; 2]; 12]; 12],
 }
@@ -144,7 +147,8 @@ pub struct RuleTable {
 impl RuleTable {
     /// Derives the table by exact sweeps against a single obstacle in each
     /// cell within reach, with tolerance `eps`.
-    pub fn derive(eps: f64) -> RuleTable {
+    pub fn derive(tolerance: Tolerance) -> RuleTable {
+        let eps = tolerance.get();
         let offsets = offsets_within_reach();
         let all = links();
         // Plain scoped threads, not rayon: the table is built inside a
@@ -221,7 +225,11 @@ impl RuleTable {
         for (i, r) in links.iter().enumerate() {
             index[r.link.from as usize][r.link.to as usize][r.link.route as usize] = i as u8;
         }
-        RuleTable { links, index }
+        RuleTable {
+            links,
+            index,
+            tolerance,
+        }
     }
 
     /// The rules of one link.
@@ -305,7 +313,13 @@ impl RuleTable {
     }
 
     /// The table as JSON (`format: "reconfcheck-rules"`).
-    pub fn to_json(&self, eps: f64) -> String {
+    /// The tolerance the table was derived with.
+    pub fn tolerance(&self) -> Tolerance {
+        self.tolerance
+    }
+
+    pub fn to_json(&self) -> String {
+        let eps = self.tolerance.get();
         let o = Cell::new(0, 0, 0);
         let links: Vec<serde_json::Value> = self
             .links
@@ -351,7 +365,7 @@ impl RuleTable {
 /// The table at the default tolerance, derived on first use.
 pub fn table() -> &'static RuleTable {
     static TABLE: OnceLock<RuleTable> = OnceLock::new();
-    TABLE.get_or_init(|| RuleTable::derive(EPSILON))
+    TABLE.get_or_init(|| RuleTable::derive(Tolerance::DEFAULT))
 }
 
 /// Cells whose occupant the move's sweep penetrates *or touches* (blocking
@@ -544,7 +558,7 @@ mod tests {
             120
         );
         assert!(text.contains(" 0→1  oct"));
-        let v: serde_json::Value = serde_json::from_str(&t.to_json(EPSILON)).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&t.to_json()).unwrap();
         assert_eq!(v["links"].as_array().unwrap().len(), 120);
         let first = &v["links"][0];
         assert!(

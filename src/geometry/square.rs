@@ -194,7 +194,7 @@ impl SweepModel for SquareSweep {
     }
 
     fn check_step(&self, input: &SweepInput<'_>) -> Vec<Contact> {
-        let eps = input.epsilon;
+        let eps = input.epsilon.get();
         let movers: Vec<(ModuleId, &Motion, Path)> = input
             .moves
             .iter()
@@ -312,7 +312,7 @@ mod tests {
             config: &config,
             moves: &list,
             moving: &moving,
-            epsilon: 1e-6,
+            epsilon: crate::geometry::Tolerance::DEFAULT,
             exact: true,
         };
         SquareSweep.check_step(&input)

@@ -53,18 +53,29 @@ impl LatticeKind {
     }
 }
 
+/// A lattice name this build does not know.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown lattice '{0}' (known: fcc, square, cubic)")]
+pub struct UnknownLattice(pub String);
+
 impl std::str::FromStr for LatticeKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownLattice;
+    fn from_str(s: &str) -> Result<Self, UnknownLattice> {
         match s {
             "fcc" => Ok(LatticeKind::Fcc),
             "square" => Ok(LatticeKind::Square),
             "cubic" => Ok(LatticeKind::Cubic),
-            other => Err(format!(
-                "unknown lattice '{other}' (known: fcc, square, cubic)"
-            )),
+            other => Err(UnknownLattice(other.to_string())),
         }
     }
+}
+
+/// A cell that is not a cell of the lattice at all.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("cell {cell} is {reason}")]
+pub struct OffLattice {
+    pub cell: Cell,
+    pub reason: &'static str,
 }
 
 /// Up to 12 neighbour cells (the FCC maximum), without allocation.
@@ -108,7 +119,7 @@ pub trait Lattice: Send + Sync + std::fmt::Debug {
     fn layer(&self, c: Cell) -> i32;
 
     /// Whether `c` is a cell of this lattice at all (the 2D lattice needs z = 0).
-    fn check_cell(&self, c: Cell) -> Result<(), String> {
+    fn check_cell(&self, c: Cell) -> Result<(), OffLattice> {
         let _ = c;
         Ok(())
     }

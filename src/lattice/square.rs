@@ -7,7 +7,7 @@
 //! around a pivot at the corner through the free adjacent cell.
 
 use super::moves::wall_slide;
-use super::{Cell, Lattice, LatticeKind, Motion, MoveError, MoveRequirements};
+use super::{Cell, Lattice, LatticeKind, Motion, MoveError, MoveRequirements, OffLattice};
 use glam::DVec3;
 
 const DIRS: [Cell; 4] = [
@@ -46,13 +46,14 @@ impl Lattice for SquareLattice {
         c.y
     }
 
-    fn check_cell(&self, c: Cell) -> Result<(), String> {
+    fn check_cell(&self, c: Cell) -> Result<(), OffLattice> {
         if c.z == 0 {
             Ok(())
         } else {
-            Err(format!(
-                "cell {c} is not in the plane of the 2D square lattice (z must be 0)"
-            ))
+            Err(OffLattice {
+                cell: c,
+                reason: "not in the plane of the 2D square lattice (z must be 0)",
+            })
         }
     }
 

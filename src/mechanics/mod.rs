@@ -18,7 +18,6 @@ pub mod analysis;
 pub mod capacity;
 pub mod closed_form;
 pub mod direct;
-pub mod loadmap;
 pub mod model;
 pub mod reuse;
 pub mod solver;

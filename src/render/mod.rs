@@ -5,8 +5,44 @@
 //! compiled in, so rendering needs no system fonts or C libraries on a
 //! fresh machine. Draw with [`SvgCanvas`] and finish with [`save`].
 
+use crate::error::Error;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
+
+mod b_study;
+mod catom;
+pub mod density;
+mod loadmap;
+mod placed;
+
+pub use b_study::plot as b_study_plot;
+pub use catom::{Picture, svg as catom_svg};
+pub use loadmap::{colour as utilisation_colour, draw as loadmap_svg};
+pub use placed::draw as placed_plot;
+
+/// Why a picture could not be drawn (plotters' and resvg's errors, as text).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct DrawError(String);
+
+/// Any drawing backend's error as a [`DrawError`], for `map_err`.
+pub fn draw_err(e: impl std::fmt::Display) -> DrawError {
+    DrawError(e.to_string())
+}
+
+/// Draws into a fresh SVG document with `draw`; a failure names `path`,
+/// the picture it was meant for.
+pub fn svg(
+    path: &Path,
+    draw: impl FnOnce(&mut String) -> Result<(), DrawError>,
+) -> Result<String, Error> {
+    let mut svg = String::new();
+    draw(&mut svg).map_err(|e| Error::Render {
+        path: path.to_path_buf(),
+        message: e.0,
+    })?;
+    Ok(svg)
+}
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
@@ -15,28 +51,32 @@ pub type SvgCanvas<'a> = plotters::backend::SVGBackend<'a>;
 
 /// Writes an SVG document to `path`: as SVG if the extension is `.svg`,
 /// otherwise rasterised to PNG at the document's own size (× `scale`).
-pub fn save(svg: &str, path: &Path, scale: f32) -> Result<(), String> {
+pub fn save(svg: &str, path: &Path, scale: f32) -> Result<(), Error> {
     let is_svg = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     if is_svg {
-        return std::fs::write(path, svg).map_err(|e| format!("{}: {e}", path.display()));
+        return crate::error::write_file(path, svg);
     }
-    let png = rasterise(svg, scale)?;
-    std::fs::write(path, png).map_err(|e| format!("{}: {e}", path.display()))
+    let png = rasterise(svg, scale).map_err(|e| Error::Render {
+        path: path.to_path_buf(),
+        message: e.0,
+    })?;
+    crate::error::write_file(path, png)
 }
 
 /// Rasterises an SVG document to PNG bytes.
-pub fn rasterise(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
+pub fn rasterise(svg: &str, scale: f32) -> Result<Vec<u8>, DrawError> {
     let opt = usvg_options();
-    let tree = resvg::usvg::Tree::from_str(svg, opt).map_err(|e| format!("bad SVG: {e}"))?;
+    let tree =
+        resvg::usvg::Tree::from_str(svg, opt).map_err(|e| draw_err(format!("bad SVG: {e}")))?;
     let size = tree
         .size()
         .to_int_size()
         .scale_by(scale)
-        .ok_or("empty picture")?;
-    let mut pixmap =
-        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("picture too large")?;
+        .ok_or_else(|| draw_err("empty picture"))?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or_else(|| draw_err("picture too large"))?;
     pixmap.fill(resvg::tiny_skia::Color::WHITE);
     resvg::render(
         &tree,
@@ -45,7 +85,7 @@ pub fn rasterise(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
     );
     pixmap
         .encode_png()
-        .map_err(|e| format!("PNG encoding failed: {e}"))
+        .map_err(|e| draw_err(format!("PNG encoding failed: {e}")))
 }
 
 fn usvg_options() -> &'static resvg::usvg::Options<'static> {

@@ -165,8 +165,7 @@ impl Schedule {
 
     /// Reads and parses a schedule file.
     pub fn load(path: &Path) -> Result<Schedule, InputError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| InputError::new(format!("cannot read: {e}")).in_file(path))?;
+        let text = crate::error::read_file(path, "schedule")?;
         Schedule::from_json(&text, path)
     }
 

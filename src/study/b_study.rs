@@ -17,6 +17,7 @@ use crate::mechanics::analysis::{Critical, Verdict};
 use crate::mechanics::capacity::required_pressure;
 use crate::mechanics::closed_form;
 use crate::mechanics::model::{Bending, Model};
+use crate::progress::Reporter;
 use crate::schedule::Schedule;
 use serde::Serialize;
 use std::path::Path;
@@ -182,16 +183,6 @@ pub fn default_range(name: &str) -> (usize, usize) {
     }
 }
 
-fn progress_bar(on: bool, b: usize, steps: usize) -> indicatif::ProgressBar {
-    let bar = crate::progress::bar(
-        on,
-        steps,
-        "b = {msg}: {bar:40} {pos}/{len} steps (eta {eta})",
-    );
-    bar.set_message(b.to_string());
-    bar
-}
-
 /// Pressures of the sweep (kPa): 1…150, SPEC §7.
 pub fn sweep_pressures() -> Vec<f64> {
     let mut v: Vec<f64> = (1..=20).map(f64::from).collect();
@@ -200,8 +191,8 @@ pub fn sweep_pressures() -> Vec<f64> {
 }
 
 /// Runs the study for `lengths` with `generate(b)` producing the schedule;
-/// `progress` draws a bar over each schedule's steps on stderr (a scaffold
-/// of the sandcastle's size takes minutes per `b`). A `b` the generator
+/// `progress` hears of every schedule's steps, one phase per `b` (a
+/// scaffold of the sandcastle's size takes minutes per `b`). A `b` the generator
 /// cannot plan is recorded in [`Study::unplanned`] and the study goes on;
 /// if no `b` can be planned, the first error is returned.
 pub fn b_study(
@@ -209,7 +200,7 @@ pub fn b_study(
     model: &Model,
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
-    progress: bool,
+    progress: &Reporter,
 ) -> Result<Study, InputError> {
     let mut rows = Vec::new();
     let mut unplanned = Vec::new();
@@ -226,7 +217,8 @@ pub fn b_study(
                 continue;
             }
         };
-        let bar = progress_bar(progress, b, schedule.steps.len() + 1);
+        let bar = progress;
+        bar.start(&format!("b = {b}"), (schedule.steps.len() + 1) as u64);
         let m = model.at_spacing(schedule.spacing.metres());
         let mut row = Row {
             b,
@@ -259,7 +251,7 @@ pub fn b_study(
             ..m.connector
         };
         replay(&schedule, &m, true, |step, s, a, out| {
-            bar.inc(1);
+            bar.advance(1);
             row.lattice_violations += out
                 .violations
                 .iter()
@@ -296,7 +288,7 @@ pub fn b_study(
                     .max(required_pressure(&load, &elastic));
             }
         })?;
-        bar.finish_and_clear();
+        bar.finish();
         if row.no_equilibrium {
             row.min_pressure_rigid_hinge = f64::INFINITY;
             row.min_pressure_elastic = f64::INFINITY;
@@ -434,166 +426,6 @@ impl Study {
         }
         s
     }
-
-    /// Plots utilisation against `b` (at the model's pressure) and the
-    /// minimum pressure against `b` (both criteria), with the closed forms.
-    pub fn plot(&self, path: &std::path::Path) -> Result<(), String> {
-        use plotters::prelude::*;
-        let mut svg = String::new();
-        {
-            let root =
-                crate::render::SvgCanvas::with_string(&mut svg, (1200, 500)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| e.to_string())?;
-            let (left, right) = root.split_horizontally(600);
-            let bmax = self.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 0.5;
-            let bmin = self.rows.iter().map(|r| r.b).min().unwrap_or(1) as f64 - 0.5;
-            let umax = self
-                .rows
-                .iter()
-                .flat_map(|r| [r.max_utilisation, r.closed_utilisation])
-                .filter(|u| u.is_finite())
-                .fold(1.2f64, f64::max)
-                * 1.05;
-            let mut c = ChartBuilder::on(&left)
-                .caption(
-                    format!(
-                        "max connector utilisation, p = {} kPa ({})",
-                        self.pressure_kpa,
-                        self.bending.name()
-                    ),
-                    ("sans-serif", 18),
-                )
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(55)
-                .build_cartesian_2d(bmin..bmax, 0.0..umax)
-                .map_err(|e| e.to_string())?;
-            c.configure_mesh()
-                .x_desc("branch length b (modules)")
-                .y_desc("load / capacity")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            c.draw_series(LineSeries::new(
-                [(bmin, 1.0), (bmax, 1.0)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
-            let sim: Vec<(f64, f64)> = self
-                .rows
-                .iter()
-                .map(|r| (r.b as f64, r.max_utilisation.min(umax)))
-                .collect();
-            c.draw_series(LineSeries::new(sim.clone(), BLUE.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label("every step, static analysis")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLUE.stroke_width(2)));
-            c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
-                .map_err(|e| e.to_string())?;
-            let closed: Vec<(f64, f64)> = self
-                .rows
-                .iter()
-                .map(|r| (r.b as f64, r.closed_utilisation.min(umax)))
-                .collect();
-            c.draw_series(LineSeries::new(closed, RED.stroke_width(1)))
-                .map_err(|e| e.to_string())?
-                .label("closed form: cantilever + agent at tip")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RED.stroke_width(1)));
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(|e| e.to_string())?;
-
-            let pmax = self
-                .rows
-                .iter()
-                .flat_map(|r| {
-                    [
-                        r.min_pressure_rigid_hinge,
-                        r.min_pressure_elastic,
-                        r.closed_pressure_elastic,
-                    ]
-                })
-                .filter(|p| p.is_finite())
-                .fold(150e3f64, f64::max)
-                / 1e3
-                * 1.5;
-            let mut c = ChartBuilder::on(&right)
-                .caption("minimum connector pressure", ("sans-serif", 18))
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(55)
-                .build_cartesian_2d(bmin..bmax, (0.1..pmax).log_scale())
-                .map_err(|e| e.to_string())?;
-            c.configure_mesh()
-                .x_desc("branch length b (modules)")
-                .y_desc("p (kPa)")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            for (kpa, label) in [
-                (15.0, "practical electroadhesion 15 kPa"),
-                (133.0, "ideal parallel plate 133 kPa"),
-            ] {
-                c.draw_series(LineSeries::new(
-                    [(bmin, kpa), (bmax, kpa)],
-                    BLACK.mix(0.5).stroke_width(1),
-                ))
-                .map_err(|e| e.to_string())?;
-                c.draw_series(std::iter::once(Text::new(
-                    label,
-                    (bmin + 0.2, kpa * 1.08),
-                    ("sans-serif", 12),
-                )))
-                .map_err(|e| e.to_string())?;
-            }
-            let series = [
-                (Bending::RigidHinge, BLUE, "rigid hinge"),
-                (Bending::Elastic, GREEN, "elastic"),
-            ];
-            for (bending, colour, name) in series {
-                let pts: Vec<(f64, f64)> = self
-                    .rows
-                    .iter()
-                    .filter(|r| r.min_pressure(bending).is_finite())
-                    .map(|r| (r.b as f64, (r.min_pressure(bending) / 1e3).max(0.1)))
-                    .collect();
-                c.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
-                    .map_err(|e| e.to_string())?
-                    .label(format!("{name}, every step"))
-                    .legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
-                    });
-                c.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
-                    .map_err(|e| e.to_string())?;
-                let closed: Vec<(f64, f64)> = self
-                    .rows
-                    .iter()
-                    .map(|r| {
-                        let p = match bending {
-                            Bending::RigidHinge => r.closed_pressure_rigid_hinge,
-                            Bending::Elastic => r.closed_pressure_elastic,
-                        };
-                        (r.b as f64, (p / 1e3).max(0.1))
-                    })
-                    .collect();
-                c.draw_series(DashedLineSeries::new(closed, 6, 4, colour.stroke_width(1)))
-                    .map_err(|e| e.to_string())?
-                    .label(format!("{name}, closed form"))
-                    .legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(1))
-                    });
-            }
-            c.configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerRight)
-                .draw()
-                .map_err(|e| e.to_string())?;
-            root.present().map_err(|e| e.to_string())?;
-        }
-        crate::render::save(&svg, path, 1.0)
-    }
 }
 
 #[cfg(test)]
@@ -610,7 +442,7 @@ mod tests {
             &model,
             &lengths,
             |b| branch_schedule(b, 3.6),
-            false,
+            &Reporter::silent(),
         )
         .unwrap();
         for r in &st.rows {
@@ -655,7 +487,7 @@ mod tests {
                 branch_schedule(b, 3.6)
             }
         };
-        let st = b_study("branch", &model, &[1, 2, 3], generate, false).unwrap();
+        let st = b_study("branch", &model, &[1, 2, 3], generate, &Reporter::silent()).unwrap();
         assert_eq!(st.rows.iter().map(|r| r.b).collect::<Vec<_>>(), [1, 3]);
         assert_eq!(st.unplanned.len(), 1);
         assert_eq!(st.unplanned[0].b, 2);
@@ -666,7 +498,7 @@ mod tests {
         // b = 1 and 3 hold; the gap at 2 neither holds nor breaks b_max.
         assert_eq!(st.b_max, 3);
         // With no schedule at all, the study fails with the first error.
-        let none = b_study("branch", &model, &[2, 2], generate, false);
+        let none = b_study("branch", &model, &[2, 2], generate, &Reporter::silent());
         assert!(none.unwrap_err().to_string().contains("module 9"));
     }
 
@@ -674,7 +506,7 @@ mod tests {
     fn the_pyramid_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
         let model = Model::default_catom();
         let generate = family("pyramid", 3.6, None, None).unwrap();
-        let st = b_study("pyramid", &model, &[4, 5, 6], generate, false).unwrap();
+        let st = b_study("pyramid", &model, &[4, 5, 6], generate, &Reporter::silent()).unwrap();
         assert_eq!(st.rows.len(), 3);
         for r in &st.rows {
             assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
@@ -726,7 +558,7 @@ mod tests {
             &model,
             &[7],
             family("cube", 3.6, Some(2), None).unwrap(),
-            false,
+            &Reporter::silent(),
         )
         .unwrap();
         let three = b_study(
@@ -734,7 +566,7 @@ mod tests {
             &model,
             &[7],
             family("cube", 3.6, Some(3), None).unwrap(),
-            false,
+            &Reporter::silent(),
         )
         .unwrap();
         let (two, three) = (&two.rows[0], &three.rows[0]);
@@ -748,7 +580,7 @@ mod tests {
     fn the_cube_family_is_lattice_clean_and_its_worst_connector_grows_with_b() {
         let model = Model::default_catom();
         let generate = family("cube", 3.6, None, None).unwrap();
-        let st = b_study("cube", &model, &[4, 5], generate, false).unwrap();
+        let st = b_study("cube", &model, &[4, 5], generate, &Reporter::silent()).unwrap();
         for r in &st.rows {
             assert_eq!(r.lattice_violations, 0, "b = {}", r.b);
             assert!(!r.no_equilibrium, "b = {}", r.b);
@@ -780,6 +612,7 @@ mod tests {
         assert!(e.to_string().contains("pyramid"), "{e}");
     }
 
+    #[cfg(feature = "render")]
     #[test]
     fn the_plot_is_written_as_png() {
         let model = Model::default_catom();
@@ -788,13 +621,13 @@ mod tests {
             &model,
             &[1, 2, 3],
             |b| branch_schedule(b, 3.6),
-            false,
+            &Reporter::silent(),
         )
         .unwrap();
         let dir = std::env::temp_dir().join(format!("reconfcheck-bstudy-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("b.png");
-        st.plot(&p).unwrap();
+        crate::render::b_study_plot(&st, &p).unwrap();
         let bytes = std::fs::read(&p).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
         std::fs::remove_dir_all(&dir).ok();

@@ -1,24 +1,11 @@
 //! The load map of one step of a schedule (`reconfcheck loadmap`).
 
 use crate::certify::load_check::replay;
-use crate::error::InputError;
+use crate::error::{Error, InputError};
+use crate::mechanics::Model;
 use crate::mechanics::analysis::Critical;
-use crate::mechanics::{Model, loadmap};
 use crate::schedule::Schedule;
 use std::path::Path;
-
-/// Why a load map could not be made.
-#[derive(Debug)]
-pub enum Error {
-    Input(InputError),
-    Output(String),
-}
-
-impl From<InputError> for Error {
-    fn from(e: InputError) -> Self {
-        Error::Input(e)
-    }
-}
 
 /// Replays `schedule` to `step` (1-based; `steps + 1` is the final
 /// configuration), analyses it with `model` and writes the load map to
@@ -67,12 +54,15 @@ pub fn render_step(
             a.max_utilisation,
             a.verdict()
         );
-        picture = Some(loadmap::draw(s, a, &title));
+        picture = Some(crate::render::loadmap_svg(s, a, &title));
     })?;
     let svg = picture
         .expect("the wanted step is replayed")
-        .map_err(Error::Output)?;
-    crate::render::save(&svg, path, 1.0).map_err(Error::Output)?;
+        .map_err(|e| Error::Render {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    crate::render::save(&svg, path, 1.0)?;
     Ok(summary)
 }
 

@@ -14,7 +14,6 @@ pub mod pas;
 pub mod random;
 pub mod sas;
 pub mod shape;
-pub mod study;
 
 use super::{Generator, parameters};
 use crate::error::InputError;
@@ -93,7 +92,7 @@ pub struct Plan {
 
 impl Plan {
     /// Runs SAS, and Alg. 3 for PAS.
-    pub fn new(shape: Shape, mode: Mode) -> Result<Plan, String> {
+    pub fn new(shape: Shape, mode: Mode) -> Result<Plan, InputError> {
         shape.validate()?;
         let run = sas::run(&shape)?;
         let times = match mode {
@@ -117,7 +116,7 @@ impl Plan {
 
     /// The schedule of this plan, and the number of movements that the
     /// sliding-square rules do not support (see [`Emitted`]).
-    pub fn schedule(&self) -> Result<Emitted, String> {
+    pub fn schedule(&self) -> Result<Emitted, InputError> {
         emit(self)
     }
 }
@@ -152,8 +151,9 @@ impl Generator for ActiveSubtraction {
                 let (w, h) = (p.width.unwrap_or(s.width), p.height.unwrap_or(s.height));
                 // The rectangle comes from the scenario, the shape from its
                 // file: the error names the scenario and quotes the file.
-                s.within(w, h)
-                    .map_err(|m| scenario.error(format!("{m} (shape {})", path.display())))?
+                s.within(w, h).map_err(|e| {
+                    scenario.error(format!("{} (shape {})", e.message, path.display()))
+                })?
             }
             (None, Some(r)) => {
                 if p.width.is_some() || p.height.is_some() {
@@ -162,7 +162,7 @@ impl Generator for ActiveSubtraction {
                     ));
                 }
                 random::random_shape_grown(r.width, r.height, r.density, r.seed, r.growth)
-                    .map_err(|m| scenario.error(m))?
+                    .map_err(|e| e.in_file(&scenario.path))?
             }
             _ => {
                 return Err(scenario.error(
@@ -170,8 +170,8 @@ impl Generator for ActiveSubtraction {
                 ));
             }
         };
-        let plan = Plan::new(shape, p.mode).map_err(|m| scenario.error(m))?;
-        let mut out = plan.schedule().map_err(|m| scenario.error(m))?;
+        let plan = Plan::new(shape, p.mode).map_err(|e| e.in_file(&scenario.path))?;
+        let mut out = plan.schedule().map_err(|e| e.in_file(&scenario.path))?;
         if let Some(r) = &p.random {
             out.schedule
                 .meta
@@ -197,7 +197,7 @@ fn pivot_for(
     moving: &FxHashSet<ModuleId>,
     from: Cell,
     to: Cell,
-) -> Result<(Option<ModuleId>, bool), String> {
+) -> Result<(Option<ModuleId>, bool), InputError> {
     let d = to - from;
     let free = |c: Cell| c.y >= 1 && config.is_free(c);
     if d.l1() == 2 {
@@ -207,9 +207,9 @@ fn pivot_for(
                 return Ok((Some(m), free(via)));
             }
         }
-        return Err(format!(
+        return Err(InputError::new(format!(
             "corner move {from} → {to} has no module at either corner to pivot on"
-        ));
+        )));
     }
     let sides = [Cell::xy(-d.y, d.x), Cell::xy(d.y, -d.x)];
     let wall = |s: Cell| supports(config, moving, from + s) && supports(config, moving, to + s);
@@ -222,13 +222,13 @@ fn pivot_for(
     match sides.iter().find_map(|&s| pivot(s)) {
         Some(m) => Ok((Some(m), false)),
         None if d.y == 0 && from.y == 1 => Ok((None, true)),
-        None => Err(format!(
+        None => Err(InputError::new(format!(
             "straight move {from} → {to} touches no module beside its start cell"
-        )),
+        ))),
     }
 }
 
-fn emit(plan: &Plan) -> Result<Emitted, String> {
+fn emit(plan: &Plan) -> Result<Emitted, InputError> {
     let shape = &plan.shape;
     let mut s = Schedule::new(LatticeKind::Square, Length::mm(50.0));
     s.ground = Some(Ground { layer: 1 });
@@ -267,7 +267,7 @@ fn emit(plan: &Plan) -> Result<Emitted, String> {
             let cells = &plan.run.removals[i].cells;
             let (from, to) = (cells[j - 1], cells[j]);
             let (pivot, ok) = pivot_for(&config, &moving, from, to)
-                .map_err(|e| format!("step {t}, module {}: {e}", ids[i]))?;
+                .map_err(|e| InputError::new(format!("step {t}, module {}: {e}", ids[i])))?;
             if !ok {
                 unsupported += 1;
             }
@@ -287,9 +287,9 @@ fn emit(plan: &Plan) -> Result<Emitted, String> {
         }
         for &(id, to) in &moves {
             if to != SINK {
-                config
-                    .insert(id, to)
-                    .map_err(|o| format!("step {t}: modules {id} and {o} meet at {}", xy(to)))?;
+                config.insert(id, to).map_err(|o| {
+                    InputError::new(format!("step {t}: modules {id} and {o} meet at {}", xy(to)))
+                })?;
             }
         }
         s.steps.push(Step { events });

@@ -14,6 +14,7 @@
 
 use super::sas::{Removal, SasRun, next_direction};
 use super::shape::{Shape, neighbours4, xy};
+use crate::error::InputError;
 use crate::lattice::Cell;
 use rustc_hash::FxHashMap;
 
@@ -212,7 +213,7 @@ fn grounded(shape: &Shape, present: &dyn Fn(Cell) -> bool) -> bool {
 /// Alg. 3: start times for the SAS removals of `run` on `shape`. Fails
 /// only if `run` is not what SAS produces on `shape` (a route Alg. 2 would
 /// not take even with every earlier module gone).
-pub fn plan(shape: &Shape, run: &SasRun) -> Result<PasTimes, String> {
+pub fn plan(shape: &Shape, run: &SasRun) -> Result<PasTimes, InputError> {
     let n = run.removals.len();
     let mut p = Planner {
         shape,
@@ -242,10 +243,10 @@ pub fn plan(shape: &Shape, run: &SasRun) -> Result<PasTimes, String> {
             match p.check(k) {
                 Ok(()) => break,
                 Err(_) if s > quiet => {
-                    return Err(format!(
+                    return Err(InputError::new(format!(
                         "removal {k} from {} does not follow Alg. 2 on this configuration",
                         xy(r.start())
-                    ));
+                    )));
                 }
                 Err(clash) => {
                     match clash {
@@ -301,7 +302,7 @@ mod tests {
         r.cells.insert(1, Cell::xy(3, 5));
         r.cells.insert(2, Cell::xy(2, 5));
         let e = plan(&u, &run).unwrap_err();
-        assert!(e.contains("does not follow Alg. 2"), "{e}");
+        assert!(e.message.contains("does not follow Alg. 2"), "{e}");
     }
 
     #[test]

@@ -13,6 +13,7 @@
 //! generated rather than SAS itself").
 
 use super::shape::{Shape, neighbours4};
+use crate::error::InputError;
 use crate::lattice::Cell;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -37,7 +38,7 @@ const MAX_ATTEMPTS: usize = 100_000;
 
 /// A non-hollow random desired configuration of density `density` (a
 /// fraction of the `width × height` modules), reproducible from `seed`.
-pub fn random_shape(width: i32, height: i32, density: f64, seed: u64) -> Result<Shape, String> {
+pub fn random_shape(width: i32, height: i32, density: f64, seed: u64) -> Result<Shape, InputError> {
     random_shape_grown(width, height, density, seed, Growth::Member)
 }
 
@@ -48,10 +49,12 @@ pub fn random_shape_grown(
     density: f64,
     seed: u64,
     growth: Growth,
-) -> Result<Shape, String> {
+) -> Result<Shape, InputError> {
     super::shape::check_rectangle(width, height)?;
     if !(density > 0.0 && density <= 1.0) {
-        return Err(format!("density {density} is not a fraction in (0, 1]"));
+        return Err(InputError::new(format!(
+            "density {density} is not a fraction in (0, 1]"
+        )));
     }
     let total = (width * height) as usize;
     let n = ((density * total as f64).round() as usize).clamp(1, total);
@@ -62,9 +65,9 @@ pub fn random_shape_grown(
             return Ok(s);
         }
     }
-    Err(format!(
+    Err(InputError::new(format!(
         "no non-hollow configuration of density {density} found in {MAX_ATTEMPTS} samples"
-    ))
+    )))
 }
 
 /// One grown sample (connected, possibly hollow).

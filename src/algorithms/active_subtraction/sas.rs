@@ -3,6 +3,7 @@
 //! sink with dynamic prioritisation (Alg. 2).
 
 use super::shape::{Shape, neighbours4, xy};
+use crate::error::InputError;
 use crate::lattice::Cell;
 
 /// The sink of seed 003 §II, at ground level West of the rectangle.
@@ -181,28 +182,28 @@ pub fn walk(
     occ: &dyn Fn(Cell) -> bool,
     tracked: &dyn Fn(Cell) -> bool,
     bound: usize,
-) -> Result<Removal, String> {
+) -> Result<Removal, InputError> {
     let mut cells = vec![start];
     let mut p = start;
     let mut last = None;
     while p != SINK {
         if cells.len() > bound {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the module from {start} did not reach the sink within {bound} moves"
-            ));
+            )));
         }
         let Some(d) = next_direction(p, last, occ) else {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the module from {} is boxed in at {}",
                 xy(start),
                 xy(p)
-            ));
+            )));
         };
         p = d.step(p);
         if !tracked(p) {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the module from {start} wandered away from the structure, to {p}"
-            ));
+            )));
         }
         cells.push(p);
         last = Some(d);
@@ -217,15 +218,16 @@ pub fn move_bound(shape: &Shape) -> usize {
 }
 
 /// Runs SAS (Alg. 1 + Alg. 2) on a validated shape.
-pub fn run(shape: &Shape) -> Result<SasRun, String> {
+pub fn run(shape: &Shape) -> Result<SasRun, InputError> {
     let mut occ = Occupancy::full(shape);
     let mut excluded: Vec<Cell> = shape.cells().filter(|&c| !shape.contains(c)).collect();
     let bound = move_bound(shape);
     let mut removals = Vec::with_capacity(excluded.len());
     while !excluded.is_empty() {
         let k = choose(&excluded, &occ).ok_or_else(|| {
-            "no excluded module has a free connector: the desired configuration is hollow"
-                .to_string()
+            InputError::new(
+                "no excluded module has a free connector: the desired configuration is hollow",
+            )
         })?;
         let m = excluded.swap_remove(k);
         occ.set(m, false);

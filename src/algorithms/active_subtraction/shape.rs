@@ -86,21 +86,20 @@ impl Shape {
 
     /// Reads, parses and validates a shape file.
     pub fn load(path: &Path) -> Result<Shape, InputError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| InputError::new(format!("cannot read shape: {e}")).in_file(path))?;
+        let text = crate::error::read_file(path, "shape")?;
         let s = Shape::parse(&text, path)?;
-        s.validate().map_err(|m| InputError::new(m).in_file(path))?;
+        s.validate().map_err(|e| e.in_file(path))?;
         Ok(s)
     }
 
     /// Places the shape at the bottom-left of a larger initial rectangle.
-    pub fn within(&self, width: i32, height: i32) -> Result<Shape, String> {
+    pub fn within(&self, width: i32, height: i32) -> Result<Shape, InputError> {
         check_rectangle(width, height)?;
         if self.width > width || self.height > height {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the desired configuration ({} × {}) is not inside the initial rectangle ({width} × {height})",
                 self.width, self.height
-            ));
+            )));
         }
         Ok(Shape::from_fn(width, height, |c| self.contains(c)))
     }
@@ -146,28 +145,30 @@ impl Shape {
     /// free space around the rectangle without crossing an included module
     /// or the ground: 4-connectivity, since a module cannot squeeze between
     /// two modules that touch at a corner).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InputError> {
         if self.width < 1 || self.height < 1 {
-            return Err("the initial rectangle is empty".into());
+            return Err(InputError::new("the initial rectangle is empty"));
         }
         if self.included_count() == 0 {
-            return Err("the desired configuration has no included module".into());
+            return Err(InputError::new(
+                "the desired configuration has no included module",
+            ));
         }
         let loose = self.disconnected();
         if let Some(c) = loose.first() {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the desired configuration is disconnected: {} included module(s) are not connected to the ground, e.g. at {}",
                 loose.len(),
                 xy(*c)
-            ));
+            )));
         }
         let enclosed = self.enclosed();
         if let Some(c) = enclosed.first() {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "the desired configuration is hollow: {} excluded cell(s) are enclosed by included modules and the ground, e.g. at {}",
                 enclosed.len(),
                 xy(*c)
-            ));
+            )));
         }
         Ok(())
     }
@@ -246,17 +247,17 @@ pub const MAX_MODULES: i64 = 1 << 22;
 
 /// Refuses an initial rectangle that is empty or larger than
 /// [`MAX_MODULES`].
-pub fn check_rectangle(width: i32, height: i32) -> Result<(), String> {
+pub fn check_rectangle(width: i32, height: i32) -> Result<(), InputError> {
     if width < 1 || height < 1 {
-        return Err(format!(
+        return Err(InputError::new(format!(
             "an initial rectangle of {width} × {height} is empty"
-        ));
+        )));
     }
     if width as i64 * height as i64 > MAX_MODULES {
-        return Err(format!(
+        return Err(InputError::new(format!(
             "an initial rectangle of {width} × {height} modules is larger than this build's \
              limit of {MAX_MODULES} modules"
-        ));
+        )));
     }
     Ok(())
 }
@@ -279,8 +280,8 @@ pub(crate) fn neighbours4(c: Cell) -> [Cell; 4] {
 mod tests {
     use super::*;
 
-    fn parse(t: &str) -> Result<Shape, String> {
-        let s = Shape::parse(t, Path::new("t.txt")).map_err(|e| e.to_string())?;
+    fn parse(t: &str) -> Result<Shape, InputError> {
+        let s = Shape::parse(t, Path::new("t.txt"))?;
         s.validate()?;
         Ok(s)
     }
@@ -298,21 +299,30 @@ mod tests {
     #[test]
     fn hollow_shapes_are_rejected() {
         let e = parse("###\n#.#\n###\n").unwrap_err();
-        assert!(e.contains("hollow") && e.contains("(2, 2)"), "{e}");
+        assert!(
+            e.message.contains("hollow") && e.message.contains("(2, 2)"),
+            "{e}"
+        );
         // A pocket closed by the ground is hollow too.
         let e = parse("###\n#.#\n").unwrap_err();
-        assert!(e.contains("hollow"), "{e}");
+        assert!(e.message.contains("hollow"), "{e}");
         // Touching at a corner closes a pocket: modules cannot pass diagonally.
         let e = parse(".#.\n#.#\n.#.\n").unwrap_err();
-        assert!(e.contains("hollow") || e.contains("disconnected"), "{e}");
+        assert!(
+            e.message.contains("hollow") || e.message.contains("disconnected"),
+            "{e}"
+        );
     }
 
     #[test]
     fn disconnected_and_floating_shapes_are_rejected() {
         let e = parse("#..\n...\n..#\n").unwrap_err();
-        assert!(e.contains("disconnected") && e.contains("(1, 3)"), "{e}");
+        assert!(
+            e.message.contains("disconnected") && e.message.contains("(1, 3)"),
+            "{e}"
+        );
         let e = parse("...\n...\n").unwrap_err();
-        assert!(e.contains("no included module"), "{e}");
+        assert!(e.message.contains("no included module"), "{e}");
     }
 
     #[test]
@@ -329,7 +339,7 @@ mod tests {
     #[test]
     fn a_shape_larger_than_the_initial_rectangle_is_rejected() {
         let s = parse("##\n##\n").unwrap();
-        assert!(s.within(1, 5).unwrap_err().contains("not inside"));
+        assert!(s.within(1, 5).unwrap_err().message.contains("not inside"));
         let big = s.within(4, 3).unwrap();
         assert_eq!(big.included_count(), 4);
         assert!(big.contains(Cell::xy(2, 2)) && !big.contains(Cell::xy(3, 1)));
@@ -337,6 +347,7 @@ mod tests {
         assert!(
             s.within(100_000, 100_000)
                 .unwrap_err()
+                .message
                 .contains("limit of 4194304")
         );
         assert!(s.within(i32::MAX, i32::MAX).is_err());

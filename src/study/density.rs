@@ -1,17 +1,16 @@
 //! The density study of seed 003 §V-B1 (Fig. 10): random desired
 //! configurations of densities 10–70 % in 10 × 10 and 20 × 20 squares, the
 //! same samples for SAS and PAS, time normalised by the number of excluded
-//! modules; a table and a box plot.
+//! modules; a table; the box plot is
+//! [`crate::render::density`]'s.
 
-use super::pas::{self, PasTimes};
-use super::random::{Growth, random_shape_grown};
-use super::sas;
-use crate::render::{SvgCanvas, save};
-use indicatif::ProgressBar;
-use plotters::prelude::*;
+use crate::algorithms::active_subtraction::pas::{self, PasTimes};
+use crate::algorithms::active_subtraction::random::{Growth, random_shape_grown};
+use crate::algorithms::active_subtraction::sas;
+use crate::error::InputError;
+use crate::progress::Reporter;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::path::Path;
 
 /// What to sample.
 #[derive(Clone, Debug, Serialize)]
@@ -95,8 +94,8 @@ fn sample_seed(base: u64, size: i32, density: u32, k: usize) -> u64 {
 }
 
 /// Runs the study (in parallel over samples). Deterministic for a config.
-pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, String> {
-    run_observed(cfg, &ProgressBar::hidden())
+pub fn run(cfg: &StudyConfig) -> Result<Vec<Sample>, InputError> {
+    run_observed(cfg, &Reporter::silent())
 }
 
 /// Samples one study draws: sizes × densities × samples.
@@ -105,7 +104,7 @@ pub fn sample_count(cfg: &StudyConfig) -> usize {
 }
 
 /// [`run`], advancing `bar` by one per sample.
-pub fn run_observed(cfg: &StudyConfig, bar: &ProgressBar) -> Result<Vec<Sample>, String> {
+pub fn run_observed(cfg: &StudyConfig, bar: &Reporter) -> Result<Vec<Sample>, InputError> {
     let jobs: Vec<(i32, u32, usize)> = cfg
         .sizes
         .iter()
@@ -124,7 +123,7 @@ pub fn run_observed(cfg: &StudyConfig, bar: &ProgressBar) -> Result<Vec<Sample>,
             let sas_t = PasTimes::sequential(&run).time_steps() as f64;
             let pas_t = pas::plan(&shape, &run)?.time_steps() as f64;
             let best = sas::best_case_time(&shape) as f64 / n;
-            bar.inc(1);
+            bar.advance(1);
             Ok(Sample {
                 size,
                 density,
@@ -220,21 +219,17 @@ pub fn rise_and_fall(rows: &[Spread]) -> Vec<(i32, usize, usize)> {
     out
 }
 
-fn spread_len(spread: &[Spread]) -> usize {
-    spread.first().map_or(0, |r| r.repeats)
-}
-
 /// Runs `repeats` studies (see [`Spread`]).
-pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, String> {
-    spread_observed(cfg, repeats, &ProgressBar::hidden())
+pub fn spread(cfg: &StudyConfig, repeats: usize) -> Result<Vec<Spread>, InputError> {
+    spread_observed(cfg, repeats, &Reporter::silent())
 }
 
 /// [`spread`], advancing `bar` by one per sample of every study.
 pub fn spread_observed(
     cfg: &StudyConfig,
     repeats: usize,
-    bar: &ProgressBar,
-) -> Result<Vec<Spread>, String> {
+    bar: &Reporter,
+) -> Result<Vec<Spread>, InputError> {
     let mut medians: Vec<Vec<Row>> = Vec::new();
     for r in 0..repeats as u64 {
         let c = StudyConfig {
@@ -348,232 +343,4 @@ pub fn table(rows: &[Row]) -> String {
         );
     }
     s
-}
-
-/// Box plot of the normalised times (log scale), like the paper's Fig. 10:
-/// per density, SAS and PAS for each size (lighter boxes: smaller size).
-pub fn plot(cfg: &StudyConfig, rows: &[Row], path: &Path) -> Result<(), String> {
-    plot_with_spread(cfg, rows, &[], path)
-}
-
-/// [`plot`], plus — when `spread` is not empty — the mean over repeated
-/// studies of each box's SAS median (a dashed line per size), which shows
-/// the expected trend behind the noise of one study's medians.
-pub fn plot_with_spread(
-    cfg: &StudyConfig,
-    rows: &[Row],
-    spread: &[Spread],
-    path: &Path,
-) -> Result<(), String> {
-    let mut svg = String::new();
-    {
-        let root = SvgCanvas::with_string(&mut svg, (960, 540)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let lo = rows
-            .iter()
-            .map(|r| r.pas.low.min(r.sas.low))
-            .fold(f64::INFINITY, f64::min)
-            .max(1e-3);
-        let hi = rows
-            .iter()
-            .map(|r| r.pas.high.max(r.sas.high))
-            .fold(0.0, f64::max)
-            .max(lo * 2.0);
-        let n = cfg.densities.len() as f64;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!(
-                    "Active subtraction: time per excluded module ({} samples per box{})",
-                    cfg.samples,
-                    match cfg.growth {
-                        Growth::Member => "",
-                        Growth::Chain => ", chain growth",
-                    }
-                ),
-                ("sans-serif", 20),
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(-0.5..n - 0.5, (lo / 1.5).log10()..(hi * 8.0).log10())
-            .map_err(|e| e.to_string())?;
-        let densities = cfg.densities.clone();
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(cfg.densities.len() + 1)
-            .x_label_formatter(&|x| {
-                let k = x.round();
-                if (x - k).abs() < 1e-6 && k >= 0.0 && (k as usize) < densities.len() {
-                    format!("{} %", densities[k as usize])
-                } else {
-                    String::new()
-                }
-            })
-            .disable_y_mesh()
-            .y_labels(0)
-            .x_desc("density of included modules ρ")
-            .y_desc("time steps / excluded module")
-            .draw()
-            .map_err(|e| e.to_string())?;
-        // Log scale by hand: the axis is log10 of the value, with ticks at
-        // 1-2-5 steps (plotters' log axis labels decades only).
-        let (y0, y1) = ((lo / 1.5).log10(), (hi * 8.0).log10());
-        let ticks: Vec<f64> = (-3..4)
-            .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
-            .filter(|t| (y0..=y1).contains(&t.log10()))
-            .collect();
-        let grey = RGBColor(200, 200, 200);
-        for &t in &ticks {
-            let y = t.log10();
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(-0.5, y), (n - 0.5, y)],
-                    grey,
-                )))
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    format!("{t}"),
-                    (-0.5 - 0.02 * n, y),
-                    ("sans-serif", 13).into_font().color(&BLACK).pos(
-                        plotters::style::text_anchor::Pos::new(
-                            plotters::style::text_anchor::HPos::Right,
-                            plotters::style::text_anchor::VPos::Center,
-                        ),
-                    ),
-                )))
-                .map_err(|e| e.to_string())?;
-        }
-        let kinds = cfg.sizes.len() * 2;
-        let width = 0.8 / kinds as f64;
-        let sas_c = RGBColor(31, 119, 180);
-        let pas_c = RGBColor(255, 127, 14);
-        for (si, &size) in cfg.sizes.iter().enumerate() {
-            for (mi, (name, colour)) in [("SAS", sas_c), ("PAS", pas_c)].into_iter().enumerate() {
-                let slot = si * 2 + mi;
-                let light = si + 1 < cfg.sizes.len();
-                let fill = if light {
-                    colour.mix(0.35).filled()
-                } else {
-                    colour.mix(0.85).filled()
-                };
-                let boxes: Vec<(f64, Summary)> = rows
-                    .iter()
-                    .filter(|r| r.size == size)
-                    .map(|r| {
-                        let k = cfg
-                            .densities
-                            .iter()
-                            .position(|&d| d == r.density)
-                            .unwrap_or(0) as f64;
-                        let x = k - 0.4 + width * (slot as f64 + 0.5);
-                        let v = if mi == 0 { r.sas } else { r.pas };
-                        let l = |x: f64| x.log10();
-                        (
-                            x,
-                            Summary {
-                                low: l(v.low),
-                                q1: l(v.q1),
-                                median: l(v.median),
-                                q3: l(v.q3),
-                                high: l(v.high),
-                            },
-                        )
-                    })
-                    .collect();
-                let half = width * 0.4;
-                chart
-                    .draw_series(
-                        boxes.iter().map(|&(x, s)| {
-                            Rectangle::new([(x - half, s.q1), (x + half, s.q3)], fill)
-                        }),
-                    )
-                    .map_err(|e| e.to_string())?
-                    .label(format!("{name} {size}×{size}"))
-                    .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], fill));
-                let black = BLACK.stroke_width(1);
-                for &(x, s) in &boxes {
-                    let lines = [
-                        vec![(x - half, s.median), (x + half, s.median)],
-                        vec![(x, s.q3), (x, s.high)],
-                        vec![(x, s.q1), (x, s.low)],
-                        vec![(x - half / 2.0, s.high), (x + half / 2.0, s.high)],
-                        vec![(x - half / 2.0, s.low), (x + half / 2.0, s.low)],
-                    ];
-                    chart
-                        .draw_series(lines.into_iter().map(|l| PathElement::new(l, black)))
-                        .map_err(|e| e.to_string())?;
-                    chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [(x - half, s.q1), (x + half, s.q3)],
-                            black,
-                        )))
-                        .map_err(|e| e.to_string())?;
-                }
-            }
-        }
-        // The paper's overlay: median best-case sequential time per size.
-        for (si, &size) in cfg.sizes.iter().enumerate() {
-            let light = si + 1 < cfg.sizes.len();
-            let style = if light {
-                BLACK.mix(0.45).stroke_width(2)
-            } else {
-                BLACK.stroke_width(2)
-            };
-            let points: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.size == size)
-                .filter_map(|r| {
-                    let k = cfg.densities.iter().position(|&d| d == r.density)? as f64;
-                    Some((k, r.best.median.log10()))
-                })
-                .collect();
-            chart
-                .draw_series(LineSeries::new(points.clone(), style))
-                .map_err(|e| e.to_string())?
-                .label(format!("best case {size}×{size} (median)"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
-            chart
-                .draw_series(
-                    points
-                        .into_iter()
-                        .map(|p| Circle::new(p, 3, style.filled())),
-                )
-                .map_err(|e| e.to_string())?;
-        }
-        for (si, &size) in cfg.sizes.iter().enumerate() {
-            let points: Vec<(f64, f64)> = spread
-                .iter()
-                .filter(|r| r.size == size)
-                .filter_map(|r| {
-                    let k = cfg.densities.iter().position(|&d| d == r.density)? as f64;
-                    Some((k, r.sas.0.log10()))
-                })
-                .collect();
-            if points.is_empty() {
-                continue;
-            }
-            let light = si + 1 < cfg.sizes.len();
-            let colour = RGBColor(31, 119, 180).mix(if light { 0.5 } else { 1.0 });
-            let style = colour.stroke_width(2);
-            chart
-                .draw_series(DashedLineSeries::new(points, 6, 4, style))
-                .map_err(|e| e.to_string())?
-                .label(format!(
-                    "SAS {size}×{size}: mean median of {} studies",
-                    spread_len(spread)
-                ))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
-    }
-    save(&svg, path, 1.0)
 }

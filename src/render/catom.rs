@@ -4,11 +4,11 @@
 //! algorithm: bodies back to front, each body's silhouette then its flat
 //! faces, Lambert-shaded), written by [`crate::render::save`].
 
-use super::EPSILON;
-use super::catom::{L, catom};
-use super::rolling::{Link, Roll};
-use super::rules::{Offset, table};
-use super::sweep::{PairOutcome, Path, sweep_pair};
+use crate::geometry::EPSILON;
+use crate::geometry::catom::{L, catom};
+use crate::geometry::rolling::{Link, Roll};
+use crate::geometry::rules::{Offset, table};
+use crate::geometry::sweep::{PairOutcome, Path, sweep_pair};
 use crate::lattice::{Cell, FccLattice, Lattice, Route, fcc};
 use glam::{DQuat, DVec2, DVec3};
 use std::fmt::Write;

@@ -3,14 +3,15 @@
 //! beyond), modules as discs (fixed ones dark), movers as open circles at
 //! the position where they load their pivot most.
 
-use super::analysis::Analysis;
-use super::structure::{End, Structure};
+use crate::mechanics::structure::End;
+use crate::mechanics::{Analysis, Structure};
+use crate::render::{DrawError, draw_err};
 use glam::DVec3;
 use plotters::prelude::*;
 
 /// Colour of a utilisation: green (0) → yellow (½) → red (1); purple > 1.
 pub fn colour(u: f64) -> RGBColor {
-    if super::capacity::overloaded(u) {
+    if crate::mechanics::capacity::overloaded(u) {
         return RGBColor(150, 0, 200);
     }
     let u = u.clamp(0.0, 1.0);
@@ -35,7 +36,7 @@ fn projector(gravity: DVec3) -> impl Fn(DVec3) -> (f64, f64, f64) {
 }
 
 /// Draws the load map of `s` with results `a` into an SVG string.
-pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> {
+pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, DrawError> {
     let proj = projector(s.gravity);
     let mut pts: Vec<(f64, f64)> = s
         .bodies
@@ -75,11 +76,11 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
     };
     let mut svg = String::new();
     {
-        let root = crate::render::SvgCanvas::with_string(&mut svg, (width.max(420), height))
-            .into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let root =
+            super::SvgCanvas::with_string(&mut svg, (width.max(420), height)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
         root.draw(&Text::new(title.to_string(), (10, 8), ("sans-serif", 16)))
-            .map_err(|e| e.to_string())?;
+            .map_err(draw_err)?;
         // Colour bar.
         for k in 0..=100 {
             let u = k as f64 / 100.0 * 1.2;
@@ -87,19 +88,19 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
                 [(10 + 3 * k, 34), (13 + 3 * k, 48)],
                 colour(u).filled(),
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(draw_err)?;
         }
         for (u, label) in [(0.0, "0"), (0.5, "0.5"), (1.0, "1"), (1.2, "> 1")] {
             let x = 10 + (u / 1.2 * 300.0) as i32;
             root.draw(&Text::new(label, (x, 50), ("sans-serif", 11)))
-                .map_err(|e| e.to_string())?;
+                .map_err(draw_err)?;
         }
         root.draw(&Text::new(
             "connector utilisation (load / capacity)",
             (320, 36),
             ("sans-serif", 12),
         ))
-        .map_err(|e| e.to_string())?;
+        .map_err(draw_err)?;
         let r = (0.22 * scale).max(2.0) as i32;
         // Far things first.
         let mut order: Vec<usize> = (0..s.bodies.len()).collect();
@@ -123,7 +124,7 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
                 RGBColor(205, 205, 205)
             };
             root.draw(&Circle::new(to_screen((x, y)), r, fill.filled()))
-                .map_err(|e| e.to_string())?;
+                .map_err(draw_err)?;
         }
         for &li in &links {
             let l = &s.links[li];
@@ -135,7 +136,7 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
             };
             let (ax, ay, _) = proj(pa);
             let (bx, by, _) = proj(pb);
-            let width = if super::capacity::overloaded(res.utilisation) {
+            let width = if crate::mechanics::capacity::overloaded(res.utilisation) {
                 4
             } else {
                 2 + (res.utilisation * 2.0) as u32
@@ -149,7 +150,7 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
                 [to_screen((ax, ay)), to_screen((bx, by))],
                 style,
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(draw_err)?;
         }
         for p in &a.pivots {
             let hang = &s.hanging[p.hanging];
@@ -161,11 +162,11 @@ pub fn draw(s: &Structure, a: &Analysis, title: &str) -> Result<String, String> 
                 [to_screen((mx, my)), to_screen((px_, py_))],
                 colour(p.utilisation).stroke_width(3),
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(draw_err)?;
             root.draw(&Circle::new(to_screen((mx, my)), r, BLACK.stroke_width(2)))
-                .map_err(|e| e.to_string())?;
+                .map_err(draw_err)?;
         }
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(draw_err)?;
     }
     Ok(svg)
 }

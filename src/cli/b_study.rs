@@ -1,0 +1,103 @@
+//! `b-study`: the branch-length study over a range of b.
+
+use reconfcheck::error::{Error, InputError, write_file};
+use reconfcheck::mechanics::{Bending, Model};
+use reconfcheck::number;
+use reconfcheck::study::b_study;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Shape family (see `study::b_study::FAMILIES`).
+    #[arg(long, default_value = "branch")]
+    family: String,
+    /// Physical model (TOML).
+    #[arg(long, value_name = "FILE", default_value = "models/catom-3.6mm.toml")]
+    model: PathBuf,
+    /// Shape size of scaffold families (pyramid: h; cube: tiles a side;
+    /// default 2).
+    #[arg(long)]
+    size: Option<u32>,
+    /// The CSG shape file of `--family csg` (e.g.
+    /// models/shapes/sandcastle.csg).
+    #[arg(long, value_name = "FILE")]
+    shape: Option<PathBuf>,
+    /// Smallest branch length (default: the family's, 1 or 4).
+    #[arg(long)]
+    b_min: Option<usize>,
+    /// Largest branch length (default: the family's, 10 or 8).
+    #[arg(long)]
+    b_max: Option<usize>,
+    /// Override the model's connector pressure (kPa, positive and finite).
+    #[arg(long)]
+    pressure: Option<f64>,
+    /// Override the model's bending criterion (elastic | rigid-hinge).
+    #[arg(long)]
+    bending: Option<Bending>,
+    /// Write the plot (PNG, or SVG by extension).
+    #[cfg(feature = "render")]
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+    /// Write the study as JSON.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// Never show a progress bar.
+    #[arg(long)]
+    no_progress: bool,
+}
+
+/// `--pressure` in kPa as the model's pressure in Pa: positive and finite
+/// before and after the conversion (1e306 kPa overflows to an infinite
+/// capacity, which would hold anything).
+fn pressure_pa(kpa: f64) -> Result<f64, InputError> {
+    number::positive(kpa)
+        .and_then(|k| number::positive(k * 1e3))
+        .map_err(|e| InputError::new(format!("--pressure (kPa): {e}")))
+}
+
+pub fn run(a: Args) -> Result<u8, Error> {
+    let mut m = Model::load(&a.model)?;
+    if a.pressure.is_some() || a.bending.is_some() {
+        let pressure = match a.pressure {
+            Some(kpa) => pressure_pa(kpa)?,
+            None => m.connector.pressure,
+        };
+        m = m.with_connector(pressure, a.bending.unwrap_or(m.connector.bending));
+    }
+    let (lo, hi) = b_study::default_range(&a.family);
+    let (b_min, b_max) = (a.b_min.unwrap_or(lo), a.b_max.unwrap_or(hi));
+    if b_min == 0 || b_min > b_max {
+        return Err(InputError::new(format!("bad range of b: {b_min}..={b_max}")).into());
+    }
+    let generate = b_study::family(&a.family, m.spacing * 1e3, a.size, a.shape.as_deref())?;
+    let lengths: Vec<usize> = (b_min..=b_max).collect();
+    let progress = super::progress::reporter(!a.no_progress, 1);
+    let st = b_study::b_study(&a.family, &m, &lengths, generate, &progress)?;
+    print!("{}", st.table());
+    #[cfg(feature = "render")]
+    if let Some(p) = &a.plot {
+        reconfcheck::render::b_study_plot(&st, p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.json {
+        write_file(
+            p,
+            serde_json::to_string_pretty(&st).expect("study serialises"),
+        )?;
+    }
+    Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pressure_that_is_not_a_positive_finite_number_of_pascals_is_refused() {
+        for kpa in [f64::NAN, f64::INFINITY, 0.0, -5.0, 1e-320, 1e306] {
+            let e = pressure_pa(kpa).unwrap_err();
+            assert!(e.message.starts_with("--pressure (kPa): "), "{e}");
+        }
+        assert_eq!(pressure_pa(52.0).unwrap(), 52e3);
+    }
+}

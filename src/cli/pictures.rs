@@ -1,0 +1,103 @@
+//! The subcommands that only draw: `render` (the catom geometry), `plot`
+//! (modules placed per step) and `loadmap` (connector utilisation).
+
+use reconfcheck::algorithms;
+use reconfcheck::certify::{self, Options};
+use reconfcheck::error::{Error, InputError};
+use reconfcheck::mechanics::Model;
+use reconfcheck::render::{self, Picture};
+use reconfcheck::scenario::Scenario;
+use reconfcheck::schedule::Schedule;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    #[arg(value_enum)]
+    picture: PictureArg,
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// The pictures `render` draws (the CLI's names for [`Picture`], kept
+/// here so the library does not depend on the argument parser).
+#[derive(Copy, Clone, Debug, clap::ValueEnum)]
+enum PictureArg {
+    /// The catom body from three directions.
+    Body,
+    /// A 90° octagonal rotation with the cells that block it.
+    Sweep,
+    /// The deepest point of a collision, with its witness points.
+    Collision,
+}
+
+pub fn render(a: RenderArgs) -> Result<u8, Error> {
+    let picture = match a.picture {
+        PictureArg::Body => Picture::Body,
+        PictureArg::Sweep => Picture::Sweep,
+        PictureArg::Collision => Picture::Collision,
+    };
+    render::save(&render::catom_svg(picture), &a.output, 1.0)?;
+    eprintln!("wrote {}", a.output.display());
+    Ok(0)
+}
+
+#[derive(clap::Args)]
+pub struct PlotArgs {
+    #[arg(required = true)]
+    scenarios: Vec<PathBuf>,
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Chart title.
+    #[arg(long, default_value = "scaffold assembly")]
+    title: String,
+}
+
+pub fn plot(a: PlotArgs) -> Result<u8, Error> {
+    let mut curves = Vec::new();
+    for p in &a.scenarios {
+        let sc = Scenario::load(p)?;
+        let s = algorithms::generate(&sc)?;
+        let v = algorithms::scaffold::plot::placed_per_step(&s);
+        eprintln!(
+            "{}: {} modules placed in {} steps",
+            sc.name,
+            v.iter().sum::<usize>(),
+            v.len()
+        );
+        curves.push((sc.name.clone(), v));
+    }
+    render::placed_plot(&curves, &a.title, &a.output)?;
+    Ok(0)
+}
+
+#[derive(clap::Args)]
+pub struct LoadmapArgs {
+    schedule: PathBuf,
+    /// Step (1-based; steps + 1 is the final configuration).
+    #[arg(long, default_value_t = 1)]
+    step: usize,
+    /// Physical model (TOML); default: the schedule's own.
+    #[arg(long, value_name = "FILE")]
+    model: Option<PathBuf>,
+    /// Output picture (PNG, or SVG by extension).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+pub fn loadmap(a: LoadmapArgs) -> Result<u8, Error> {
+    let s = Schedule::load(&a.schedule)?;
+    let opts = Options {
+        model: a.model,
+        base_dir: a.schedule.parent().map(Path::to_path_buf),
+        ..Default::default()
+    };
+    let path = certify::model_path(&s, &opts).ok_or_else(|| {
+        InputError::new("no model: pass --model FILE or name one in the schedule")
+            .in_file(&a.schedule)
+    })?;
+    let m = Model::load(&path)?;
+    let summary = reconfcheck::study::loadmap::render_step(&s, &m, a.step, &a.output)
+        .map_err(|e| e.in_file(&a.schedule))?;
+    println!("{summary}");
+    Ok(0)
+}
