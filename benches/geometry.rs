@@ -8,7 +8,7 @@ use reconfcheck::algorithms::random_walk::{WalkParams, collision_free, walk};
 use reconfcheck::certify::{Options, certify};
 use reconfcheck::geometry::fcc_sweep::FccSweep;
 use reconfcheck::geometry::rules::{offsets_within_reach, table};
-use reconfcheck::geometry::{EPSILON, SweepInput, SweepModel};
+use reconfcheck::geometry::{SweepInput, SweepModel};
 use reconfcheck::lattice::config::ModuleId;
 use reconfcheck::lattice::{Cell, Configuration, FccLattice, Lattice, Motion, Route};
 use rustc_hash::FxHashSet;

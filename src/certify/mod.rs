@@ -496,4 +496,45 @@ mod tests {
         assert_eq!(seen.len(), 1, "no range instance was made");
         assert_eq!(seen[0], (1..=s.steps.len()).collect::<Vec<_>>());
     }
+
+    /// A model whose numbers were made in code, not read and validated:
+    /// whatever turns non-finite, the load check must not certify.
+    #[test]
+    fn non_finite_model_numbers_never_certify_a_structure() {
+        use crate::mechanics::Model;
+        let s = crate::algorithms::branch::branch_schedule(3, 3.6).unwrap();
+        let edits: [(&str, fn(&mut Model)); 6] = [
+            ("mass NaN", |m| m.mass = f64::NAN),
+            ("mass ∞", |m| m.mass = f64::INFINITY),
+            ("gravity NaN", |m| m.gravity = f64::NAN),
+            ("gravity ∞", |m| m.gravity = f64::INFINITY),
+            ("pressure NaN", |m| m.connector.pressure = f64::NAN),
+            ("friction NaN", |m| m.connector.friction = f64::NAN),
+        ];
+        for (what, edit) in edits {
+            let mut m = Model::default_catom();
+            edit(&mut m);
+            let check = LoadCheck::new(&m, s.spacing.metres(), true);
+            let r = certify_with(&s, &Options::default(), &[&LatticeCheck, &check]).unwrap();
+            assert!(!r.certified, "{what}: certified");
+            assert!(
+                r.violations.iter().any(|v| v.kind == ViolationKind::Overload
+                    || v.kind == ViolationKind::Unstable),
+                "{what}: {:?}",
+                r.violations
+            );
+        }
+    }
+
+    #[test]
+    fn a_non_finite_utilisation_is_overloaded_and_ranks_above_every_finite_one() {
+        use crate::mechanics::capacity::{overloaded, severity};
+        for u in [f64::NAN, f64::INFINITY, -f64::INFINITY, 1.0 + 1e-6] {
+            assert!(overloaded(u), "{u}");
+        }
+        for u in [0.0, 0.5, 1.0, 1.0 + 1e-10] {
+            assert!(!overloaded(u), "{u}");
+        }
+        assert!(severity(f64::NAN) > severity(1e300));
+    }
 }

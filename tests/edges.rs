@@ -1,0 +1,103 @@
+//! Numbers at the boundary: every numeric flag is validated before any
+//! library code runs. A NaN compares false with every limit, an infinity or
+//! a huge tolerance turns a collision into "within limits": each must be
+//! refused with exit code 2 naming the flag, never certified.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reconfcheck-edges-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// The bundled walk's first step, with a fixed module at (1, −1, 1) that
+/// the first rotation (0,0,1) → (1,0,1) about (1,0,0) cuts 0.28 d deep.
+fn penetrating_schedule(tag: &str) -> PathBuf {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"),
+    )
+    .unwrap();
+    let mut s: Value = serde_json::from_str(&text).unwrap();
+    s["steps"].as_array_mut().unwrap().truncate(1);
+    s["modules"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"id": 900, "cell": [1, -1, 1], "fixed": true}));
+    let p = scratch(&format!("penetrating-{tag}.json"));
+    std::fs::write(&p, s.to_string()).unwrap();
+    p
+}
+
+fn certify_with(epsilon: &str, exact: bool) -> Output {
+    let mut cmd = bin();
+    cmd.arg("certify")
+        .arg(penetrating_schedule(&format!("{epsilon}-{exact}")))
+        .arg(format!("--epsilon={epsilon}"))
+        .arg("--no-progress");
+    if exact {
+        cmd.arg("--exact");
+    }
+    cmd.output().unwrap()
+}
+
+#[test]
+fn a_tolerance_that_is_not_in_its_range_is_refused_naming_the_flag() {
+    for eps in [
+        "nan", "NaN", "inf", "-inf", "-1", "0", "1e9", "0.2", "1e-320",
+    ] {
+        for exact in [false, true] {
+            let o = certify_with(eps, exact);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "--epsilon {eps}: {err}");
+            assert!(err.contains("--epsilon"), "--epsilon {eps}: {err}");
+            assert!(!String::from_utf8_lossy(&o.stdout).contains("CERTIFIED"));
+        }
+    }
+}
+
+#[test]
+fn the_penetration_is_a_collision_at_every_accepted_tolerance() {
+    // The largest tolerance accepted is far below the 0.28 d penetration:
+    // no valid ε can certify it, by table or by exact sweep.
+    for eps in ["1e-6", "1e-3", "0.1"] {
+        for exact in [false, true] {
+            let o = certify_with(eps, exact);
+            let out = String::from_utf8_lossy(&o.stdout);
+            assert_eq!(o.status.code(), Some(1), "--epsilon {eps}: {out}");
+            assert!(out.contains("collision"), "--epsilon {eps}: {out}");
+        }
+    }
+}
+
+#[test]
+fn a_pressure_that_is_not_a_positive_finite_number_is_refused_by_the_b_study() {
+    for kpa in ["nan", "inf", "-1", "0", "1e306"] {
+        let o = bin()
+            .args([
+                "b-study",
+                "--family",
+                "branch",
+                "--b-max",
+                "3",
+                "--no-progress",
+            ])
+            .arg(format!("--pressure={kpa}"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--pressure {kpa}: {err}");
+        assert!(err.contains("--pressure"), "--pressure {kpa}: {err}");
+        assert!(
+            o.stdout.is_empty(),
+            "no study is printed for --pressure {kpa}"
+        );
+    }
+}
