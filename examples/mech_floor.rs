@@ -23,10 +23,10 @@ fn main() {
         let plan = world.resolve(k + 1, step).unwrap();
         if (k + 1) % every == 0 {
             let scene = SceneRef {
-                lattice: world.lattice,
-                ground: world.ground,
-                config: &world.config,
-                fixed: &world.fixed,
+                lattice: world.lattice(),
+                ground: world.ground(),
+                config: world.config(),
+                fixed: world.fixed(),
                 exclude: &plan.moving,
                 latched: &|a, b| world.latched(a, b),
             };

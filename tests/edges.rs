@@ -101,3 +101,81 @@ fn a_pressure_that_is_not_a_positive_finite_number_is_refused_by_the_b_study() {
         );
     }
 }
+
+#[test]
+fn a_collision_names_the_cells_of_both_modules_and_the_link() {
+    let o = bin()
+        .arg("certify")
+        .arg(penetrating_schedule("cells"))
+        .args(["--print-json", "--no-progress"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = report["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["kind"] == "collision")
+        .expect("a collision");
+    // The mover's start and target, then the penetrated module's cell.
+    assert_eq!(
+        v["cells"],
+        serde_json::json!([[0, 0, 1], [1, 0, 1], [1, -1, 1]])
+    );
+    assert_eq!(v["detail"]["pivot_cell"], serde_json::json!([1, 0, 0]));
+    assert_eq!(v["detail"]["route"], "octagonal");
+}
+
+/// Three catoms in a row with neither ground nor fixed module: the end one
+/// rolls up onto the middle one and back. A free-floating structure is
+/// connected when it is one component, on every step (the incremental
+/// check once had no anchor to look for and reported it loose).
+#[test]
+fn a_free_floating_structure_that_stays_one_component_is_connected_on_every_step() {
+    use reconfcheck::certify::{Options, certify};
+    use reconfcheck::lattice::{Cell, LatticeKind, Route};
+    use reconfcheck::schedule::{Event, Length, ModuleSpec, Schedule, Step};
+    let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+    for x in 0..3 {
+        s.modules.push(ModuleSpec {
+            id: x as u32,
+            cell: Cell::new(x, 0, 0),
+            fixed: false,
+        });
+    }
+    let (down, up) = (Cell::new(2, 0, 0), Cell::new(1, 0, 1));
+    for (from, to) in [(down, up), (up, down), (down, up), (up, down)] {
+        s.steps.push(Step {
+            events: vec![Event::Rotate {
+                module: 2,
+                pivot: 1,
+                from,
+                to,
+                route: Route::Octagonal,
+            }],
+        });
+    }
+    let r = certify(&s, &Options::lattice_only()).unwrap();
+    assert!(r.certified, "{:?}", r.violations);
+    // Splitting it is still a disconnection: the middle module rolls up
+    // on the end one, and the first is left on its own.
+    s.steps.clear();
+    s.steps.push(Step {
+        events: vec![Event::Rotate {
+            module: 1,
+            pivot: 2,
+            from: Cell::new(1, 0, 0),
+            to: Cell::new(1, 0, 1),
+            route: Route::Octagonal,
+        }],
+    });
+    let r = certify(&s, &Options::lattice_only()).unwrap();
+    assert!(!r.certified);
+    let loose: Vec<_> = r
+        .violations
+        .iter()
+        .filter(|v| v.kind == reconfcheck::certify::ViolationKind::Disconnected)
+        .collect();
+    assert!(!loose.is_empty(), "{:?}", r.violations);
+}

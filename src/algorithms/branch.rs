@@ -127,9 +127,9 @@ mod tests {
             w.apply(&plan);
         }
         for x in 0..=5 {
-            assert!(w.config.at(Cell::new(x, 0, 0)).is_some(), "x = {x}");
+            assert!(w.config().at(Cell::new(x, 0, 0)).is_some(), "x = {x}");
         }
-        assert_eq!(w.config.len(), 6);
+        assert_eq!(w.config().len(), 6);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use super::report::{Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
 use crate::geometry::{Contact, ContactKind, SweepInput, SweepModel};
+use crate::lattice::Motion;
 
 /// Runs a sweep model on every step.
 pub struct CollisionCheck {
@@ -23,8 +24,8 @@ impl StepCheck for CollisionCheck {
             return;
         }
         let input = SweepInput {
-            lattice: ctx.world.lattice,
-            config: &ctx.world.config,
+            lattice: ctx.world.lattice(),
+            config: ctx.world.config(),
             moves: &moves,
             moving: &ctx.plan.moving,
             epsilon: self.epsilon,
@@ -33,7 +34,7 @@ impl StepCheck for CollisionCheck {
         let mut deepest: f64 = 0.0;
         for c in self.model.check_step(&input) {
             deepest = deepest.max(c.depth);
-            let v = contact_violation(&c, ctx.plan.step);
+            let v = contact_violation(&c, ctx);
             match c.kind {
                 ContactKind::Collision => out.violations.push(v),
                 ContactKind::SlidingContact => out.warnings.push(v),
@@ -45,12 +46,24 @@ impl StepCheck for CollisionCheck {
     }
 }
 
-fn contact_violation(c: &Contact, step: usize) -> Violation {
+/// The violation (or warning) of one contact, with the cells it concerns:
+/// the mover's start and target cells (its link), then the other module's
+/// cell at the start of the step; the pivot's cell and the route are in the
+/// details.
+fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
+    let step = ctx.plan.step;
+    let config = ctx.world.config();
+    let motion = ctx
+        .plan
+        .moves
+        .iter()
+        .find(|m| m.module == c.mover)
+        .map(|m| &m.motion);
     let (kind, what) = match c.kind {
         ContactKind::Collision => (ViolationKind::Collision, "penetrates"),
         ContactKind::SlidingContact => (ViolationKind::SlidingContact, "slides in contact with"),
     };
-    Violation::new(
+    let v = Violation::new(
         kind,
         step,
         format!(
@@ -59,8 +72,19 @@ fn contact_violation(c: &Contact, step: usize) -> Violation {
         ),
     )
     .modules([c.mover, c.other])
+    .cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten())
+    .cells(config.cell_of(c.other))
     .detail("s", c.s)
     .detail("depth", c.depth)
     .detail("witness_mover", c.witness_mover.to_array())
-    .detail("witness_other", c.witness_other.to_array())
+    .detail("witness_other", c.witness_other.to_array());
+    match motion {
+        Some(Motion::Rotate { pivot, route, .. }) => {
+            v.detail("pivot_cell", pivot).detail("route", route)
+        }
+        Some(Motion::Slide {
+            pivot: Some(pivot), ..
+        }) => v.detail("pivot_cell", pivot),
+        _ => v,
+    }
 }

@@ -51,7 +51,7 @@ impl StepCheck for LatticeCheck {
                 }
             }
             for &c in &m.requirements.supports {
-                let pivot_cell = m.pivot.and_then(|p| w.config.cell_of(p));
+                let pivot_cell = m.pivot.and_then(|p| w.config().cell_of(p));
                 if Some(c) == pivot_cell && m.pivot.is_some_and(|p| moving.contains(&p)) {
                     continue; // already reported as a moving pivot
                 }
@@ -65,7 +65,7 @@ impl StepCheck for LatticeCheck {
                                 m.module,
                                 m.motion.from(),
                                 m.motion.to(),
-                                if w.config.is_free(c) { "empty" } else { "moving" }
+                                if w.config().is_free(c) { "empty" } else { "moving" }
                             ),
                         )
                         .modules([m.module])
@@ -74,7 +74,7 @@ impl StepCheck for LatticeCheck {
                 }
             }
             for &c in &m.requirements.occupied {
-                if w.config.is_free(c) {
+                if w.config().is_free(c) {
                     out.violations.push(
                         Violation::new(
                             ViolationKind::MoverDetached,
@@ -87,7 +87,7 @@ impl StepCheck for LatticeCheck {
                 }
             }
             for &c in &m.requirements.pass_through {
-                if !w.config.is_free(c) || targets.contains(&c) {
+                if !w.config().is_free(c) || targets.contains(&c) {
                     out.violations.push(
                         Violation::new(
                             ViolationKind::PassageBlocked,
@@ -100,7 +100,7 @@ impl StepCheck for LatticeCheck {
                             ),
                         )
                         .modules([m.module])
-                        .modules(w.config.at(c))
+                        .modules(w.config().at(c))
                         .cells([c]),
                     );
                 }
@@ -108,7 +108,7 @@ impl StepCheck for LatticeCheck {
         }
 
         for &(id, cell) in &plan.enters {
-            if !w.sources.is_empty() && !w.sources.contains(&cell) {
+            if !w.may_enter_at(cell) {
                 out.violations.push(
                     Violation::new(
                         ViolationKind::NotASource,
@@ -120,7 +120,7 @@ impl StepCheck for LatticeCheck {
                 );
             }
             let held = w
-                .lattice
+                .lattice()
                 .neighbours(cell)
                 .iter()
                 .any(|&n| w.is_support(n, moving));
@@ -143,8 +143,8 @@ impl StepCheck for LatticeCheck {
                 .iter()
                 .find(|m| m.module == id)
                 .map(|m| m.motion.to())
-                .or_else(|| w.config.cell_of(id));
-            if let Some(c) = end.filter(|c| !w.sinks.contains(c)) {
+                .or_else(|| w.config().cell_of(id));
+            if let Some(c) = end.filter(|&c| !w.may_leave_from(c)) {
                 out.violations.push(
                     Violation::new(
                         ViolationKind::NotASink,
@@ -158,9 +158,9 @@ impl StepCheck for LatticeCheck {
         }
 
         for &(a, b) in plan.attaches.iter().chain(&plan.detaches) {
-            let (ca, cb) = (w.config.cell_of(a), w.config.cell_of(b));
+            let (ca, cb) = (w.config().cell_of(a), w.config().cell_of(b));
             if let (Some(ca), Some(cb)) = (ca, cb)
-                && !w.lattice.are_neighbours(ca, cb)
+                && !w.lattice().are_neighbours(ca, cb)
                 && !moving.contains(&a)
                 && !moving.contains(&b)
             {

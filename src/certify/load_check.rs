@@ -50,10 +50,10 @@ impl LoadCheck {
         movers: &[MoverSpec],
     ) -> (Structure, Analysis) {
         let scene = SceneRef {
-            lattice: world.lattice,
-            ground: world.ground,
-            config: &world.config,
-            fixed: &world.fixed,
+            lattice: world.lattice(),
+            ground: world.ground(),
+            config: world.config(),
+            fixed: world.fixed(),
             exclude,
             latched: &|a, b| world.latched(a, b),
         };

@@ -246,9 +246,7 @@ pub fn certify_with(
     bar.start("certifying", (passes * schedule.steps.len()) as u64);
 
     // The initial configuration must stand on its own.
-    let nobody = Default::default();
-    let loose = world.unanchored(&nobody);
-    world.set_anchored(loose.is_empty());
+    let loose = world.check_anchored();
     if !loose.is_empty() {
         report.violations.push(
             Violation::new(
@@ -281,7 +279,9 @@ pub fn certify_with(
             .iter()
             .any(|m| matches!(m.motion, crate::lattice::Motion::Tunnel { .. }));
         let lattice_clean = out.violations.iter().all(|v| !v.kind.is_lattice_level());
-        world.set_anchored(lattice_clean && plan.detaches.is_empty() && !tunnels);
+        if lattice_clean && plan.detaches.is_empty() && !tunnels {
+            world.confirm_anchored();
+        }
         out.violations.extend(clashes);
         report.per_step.push(StepResult {
             step: index,
@@ -317,8 +317,7 @@ pub fn certify_with(
 
     if report.stopped_at.is_none() {
         let final_step = schedule.steps.len() + 1;
-        world.set_anchored(false);
-        let loose = world.unanchored(&nobody);
+        let loose = world.check_anchored();
         if !loose.is_empty() {
             report.violations.push(
                 Violation::new(

@@ -8,15 +8,17 @@ use crate::lattice::{Cell, Configuration, Lattice, Motion, MoveRequirements};
 use crate::schedule::{Event, Schedule, Step};
 use rustc_hash::{FxHashMap, FxHashSet};
 
-/// The scene between two time steps.
+/// The scene between two time steps. Its state changes only through
+/// [`World::apply`], so the connectivity cache (`anchored`) cannot fall out
+/// of step with the configuration; checks read it through accessors.
 #[derive(Clone, Debug)]
 pub struct World {
-    pub lattice: &'static dyn Lattice,
-    pub ground: Option<Ground>,
-    pub config: Configuration,
-    pub fixed: FxHashSet<ModuleId>,
-    pub sources: FxHashSet<Cell>,
-    pub sinks: FxHashSet<Cell>,
+    lattice: &'static dyn Lattice,
+    ground: Option<Ground>,
+    config: Configuration,
+    fixed: FxHashSet<ModuleId>,
+    sources: FxHashSet<Cell>,
+    sinks: FxHashSet<Cell>,
     detached: FxHashSet<(ModuleId, ModuleId)>,
     /// Every id that was ever in the scene, and the step it left at.
     left_at: FxHashMap<ModuleId, usize>,
@@ -129,6 +131,35 @@ impl World {
         Ok(())
     }
 
+    pub fn lattice(&self) -> &'static dyn Lattice {
+        self.lattice
+    }
+
+    pub fn ground(&self) -> Option<Ground> {
+        self.ground
+    }
+
+    /// Which module is in which cell.
+    pub fn config(&self) -> &Configuration {
+        &self.config
+    }
+
+    /// The modules that never move (anchors, like the ground).
+    pub fn fixed(&self) -> &FxHashSet<ModuleId> {
+        &self.fixed
+    }
+
+    /// Whether a module may enter the scene at `c`: anywhere when the
+    /// schedule names no source cells.
+    pub fn may_enter_at(&self, c: Cell) -> bool {
+        self.sources.is_empty() || self.sources.contains(&c)
+    }
+
+    /// Whether a module may leave the scene from `c`: only at a sink cell.
+    pub fn may_leave_from(&self, c: Cell) -> bool {
+        self.sinks.contains(&c)
+    }
+
     pub fn latched(&self, a: ModuleId, b: ModuleId) -> bool {
         !self.detached.contains(&pair(a, b))
     }
@@ -152,10 +183,17 @@ impl World {
     /// to them ([`Configuration::unanchored_near`]): a step then costs in
     /// proportion to the movers' surroundings, not to the whole structure.
     /// With any latch released the full search runs (a mover could have come
-    /// to rest beside a module it is unlatched from).
+    /// to rest beside a module it is unlatched from), and so it does in a
+    /// scene with neither ground nor fixed modules: there a structure is
+    /// connected when it is one component, and the local search, which
+    /// looks for anchors, would find none.
+    ///
+    /// This is the one place connectivity is decided: the lattice check and
+    /// the initial and final checks all ask it.
     pub fn unanchored(&self, exclude: &FxHashSet<ModuleId>) -> Vec<ModuleId> {
         let latched = |a, b| self.latched(a, b);
-        if self.anchored && self.detached.is_empty() {
+        let has_anchor = self.ground.is_some() || !self.fixed.is_empty();
+        if self.anchored && self.detached.is_empty() && has_anchor {
             self.config
                 .unanchored_near(self.lattice, self.ground, &self.fixed, exclude, &latched)
         } else {
@@ -164,12 +202,23 @@ impl World {
         }
     }
 
-    /// Records whether every module is known to be anchored now. True only
-    /// when established: by a full check, or by a step with no violations
-    /// and no released latches (its static part was anchored and each mover
-    /// ended latched to a static pivot or support).
-    pub fn set_anchored(&mut self, anchored: bool) {
-        self.anchored = anchored;
+    /// Runs the full connectivity search over the whole scene and records
+    /// its answer: the modules not connected to an anchor (none: the scene
+    /// is known to be anchored from now on, until a step says otherwise).
+    pub fn check_anchored(&mut self) -> Vec<ModuleId> {
+        self.anchored = false;
+        let loose = self.unanchored(&FxHashSet::default());
+        self.anchored = loose.is_empty();
+        loose
+    }
+
+    /// After [`World::apply`]: records that the step just applied kept every
+    /// module anchored, which the caller establishes from its lattice
+    /// checks: a step with no lattice-level violation, no released latch
+    /// and no tunnel had an anchored static part, and each mover ended
+    /// latched to a static pivot or support.
+    pub fn confirm_anchored(&mut self) {
+        self.anchored = true;
     }
 
     fn require_present(&self, id: ModuleId, step: usize) -> Result<Cell, InputError> {
@@ -315,8 +364,10 @@ impl World {
     }
 
     /// Applies a step. Returns the occupancy clashes (two modules ending in
-    /// one cell); on a clash the later module stays where it was.
+    /// one cell); on a clash the later module stays where it was. The scene
+    /// is no longer known to be anchored (see [`World::confirm_anchored`]).
     pub fn apply(&mut self, plan: &StepPlan) -> Vec<Violation> {
+        self.anchored = false;
         let mut clashes = Vec::new();
         for m in &plan.moves {
             self.config.remove(m.module);
