@@ -96,7 +96,7 @@ pub fn loadmap(a: LoadmapArgs) -> Result<u8, Error> {
             .in_file(&a.schedule)
     })?;
     let m = Model::load(&path)?;
-    let summary = reconfcheck::study::loadmap::render_step(&s, &m, a.step, &a.output)
+    let summary = reconfcheck::render::loadmap(&s, &m, a.step, &a.output)
         .map_err(|e| e.in_file(&a.schedule))?;
     println!("{summary}");
     Ok(0)

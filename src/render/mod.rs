@@ -17,7 +17,7 @@ mod placed;
 
 pub use b_study::plot as b_study_plot;
 pub use catom::{Picture, svg as catom_svg};
-pub use loadmap::{colour as utilisation_colour, draw as loadmap_svg};
+pub use loadmap::{colour as utilisation_colour, draw as loadmap_svg, render_step as loadmap};
 pub use placed::draw as placed_plot;
 
 /// Why a picture could not be drawn (plotters' and resvg's errors, as text).

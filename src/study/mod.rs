@@ -1,7 +1,7 @@
-//! Studies built on certification: the branch-length (`b`) upper bound.
+//! Studies: questions asked over many schedules. The branch-length (`b`)
+//! upper bound, seed 003's density study, and synthetic workloads for the
+//! benchmarks. Their pictures are drawn by [`crate::render`].
 
 pub mod b_study;
 pub mod density;
-#[cfg(feature = "render")]
-pub mod loadmap;
 pub mod synthetic;
