@@ -6,10 +6,10 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use reconfcheck::algorithms::random_walk::{WalkParams, collision_free, walk};
 use reconfcheck::certify::{Options, certify};
-use reconfcheck::geometry::fcc_sweep::FccSweep;
-use reconfcheck::geometry::rules::{offsets_within_reach, table};
+use reconfcheck::geometry::FccSweep;
 use reconfcheck::geometry::{SweepInput, SweepModel};
-use reconfcheck::lattice::config::ModuleId;
+use reconfcheck::geometry::{offsets_within_reach, table};
+use reconfcheck::lattice::ModuleId;
 use reconfcheck::lattice::{Cell, Configuration, FccLattice, Lattice, Motion, Route};
 use rustc_hash::FxHashSet;
 use std::hint::black_box;

@@ -14,7 +14,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use reconfcheck::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
-use reconfcheck::certify::load_check::replay;
+use reconfcheck::certify::replay;
 use reconfcheck::mechanics::Model;
 use reconfcheck::schedule::Schedule;
 use reconfcheck::study::synthetic::islands_with_walkers;

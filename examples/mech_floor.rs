@@ -4,10 +4,10 @@
 //! step (best of three solves; the factor as `direct::Factor::new` does it).
 //! `cargo run --release --example mech_floor -- SCENARIO EVERY`
 use reconfcheck::certify::World;
-use reconfcheck::mechanics::direct::Factor;
-use reconfcheck::mechanics::solver::Vec6;
-use reconfcheck::mechanics::structure::{SceneRef, Structure};
+use reconfcheck::mechanics::Factor;
+use reconfcheck::mechanics::Vec6;
 use reconfcheck::mechanics::{Analyzer, Model};
+use reconfcheck::mechanics::{SceneRef, Structure};
 use reconfcheck::scenario::Scenario;
 use std::time::Instant;
 fn main() {

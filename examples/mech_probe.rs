@@ -1,6 +1,6 @@
 //! Probe: time the mechanics replay of a synthetic workload.
 //! `cargo run --release --example mech_probe -- N W H WALKERS STEPS INCREMENTAL(0|1)`
-use reconfcheck::certify::load_check::replay;
+use reconfcheck::certify::replay;
 use reconfcheck::mechanics::Model;
 use reconfcheck::study::synthetic::islands_with_walkers;
 use std::time::Instant;

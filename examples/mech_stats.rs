@@ -2,7 +2,7 @@
 //! links, movers, bodies added/removed, factorisations, CG iterations).
 //! `cargo run --release --example mech_stats -- SCENARIO [INCREMENTAL(1|0)] [STEPS]`
 //! prints every 50th step, or every step with `ALL=1` in the environment.
-use reconfcheck::certify::load_check::replay;
+use reconfcheck::certify::replay;
 use reconfcheck::mechanics::Model;
 use reconfcheck::scenario::Scenario;
 use rustc_hash::FxHashSet;

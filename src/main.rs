@@ -94,7 +94,7 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
         Command::Loadmap(a) => cli::pictures::loadmap(a),
         Command::DensityStudy(a) => cli::density::run(a),
         Command::Rules { json } => {
-            let t = reconfcheck::geometry::rules::table();
+            let t = reconfcheck::geometry::table();
             print!("{}", t.to_text());
             if let Some(p) = json {
                 write_file(&p, t.to_json())?;

@@ -3,7 +3,7 @@
 mod common;
 use common::*;
 use reconfcheck::certify::ViolationKind::*;
-use reconfcheck::lattice::config::Ground;
+use reconfcheck::lattice::Ground;
 use reconfcheck::lattice::{Cell, LatticeKind};
 use reconfcheck::schedule::{Event, Length, ModuleSpec, Schedule};
 

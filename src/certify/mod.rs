@@ -4,15 +4,15 @@
 //! Checks implement [`StepCheck`]; the lattice checks always run, geometric
 //! and mechanical checks join them where the lattice has a model for them.
 
-pub mod collision_check;
-pub mod lattice_check;
-pub mod load_check;
-pub mod report;
-pub mod world;
+pub(crate) mod collision_check;
+pub(crate) mod lattice_check;
+pub(crate) mod load_check;
+pub(crate) mod report;
+pub(crate) mod world;
 
 pub use collision_check::CollisionCheck;
 pub use lattice_check::LatticeCheck;
-pub use load_check::LoadCheck;
+pub use load_check::{LoadCheck, replay};
 pub use report::{Report, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 

@@ -12,7 +12,9 @@
 //! Units: lattice spacing `d = 1`. Orientation at rest (SPEC §1): the
 //! catom's cubic axes are `(x̂+ŷ)/√2`, `(x̂−ŷ)/√2`, `ẑ`.
 
-use glam::{DQuat, DVec3};
+#[cfg(test)]
+use glam::DQuat;
+use glam::DVec3;
 use parry3d_f64::math::Pose;
 use parry3d_f64::query;
 use parry3d_f64::shape::{ConvexPolyhedron, RoundShape};
@@ -149,6 +151,7 @@ impl Catom {
 }
 
 /// A rigid pose from a centre and a rotation.
+#[cfg(test)]
 pub fn pose(centre: DVec3, rotation: DQuat) -> Pose {
     Pose::from_parts(centre, rotation)
 }

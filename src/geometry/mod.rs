@@ -4,11 +4,11 @@
 //! asks [`sweep_model`] for the one of the schedule's lattice and turns the
 //! contacts it reports into violations and warnings.
 
-pub mod catom;
-pub mod fcc_sweep;
-pub mod rolling;
-pub mod rules;
-pub mod sweep;
+pub(crate) mod catom;
+pub(crate) mod fcc_sweep;
+pub(crate) mod rolling;
+pub(crate) mod rules;
+pub(crate) mod sweep;
 
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
@@ -16,7 +16,12 @@ use glam::DVec3;
 use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 
-pub mod square;
+pub(crate) mod square;
+
+pub use catom::catom;
+pub use fcc_sweep::FccSweep;
+pub use rules::{FccRules, LinkRules, RuleTable, offsets_within_reach, table};
+pub use square::SquareSweep;
 
 /// Default certification tolerance, in units of the lattice spacing d.
 pub const EPSILON: f64 = 1e-6;

@@ -259,6 +259,7 @@ impl Roll {
     }
 
     /// Unit direction pivot → target.
+    #[cfg(test)]
     pub fn target_normal(&self) -> DVec3 {
         self.n_t
     }

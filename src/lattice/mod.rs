@@ -6,16 +6,16 @@
 //! lattice they are working with.
 
 mod cell;
-pub mod config;
-pub mod cubic;
-pub mod fcc;
-pub mod moves;
-pub mod square;
+pub(crate) mod config;
+pub(crate) mod cubic;
+pub(crate) mod fcc;
+pub(crate) mod moves;
+pub(crate) mod square;
 
 pub use cell::Cell;
-pub use config::Configuration;
+pub use config::{Configuration, Ground, ModuleId};
 pub use cubic::CubicLattice;
-pub use fcc::FccLattice;
+pub use fcc::{FccLattice, directions as fcc_directions};
 pub use moves::{Motion, MoveError, MoveRequirements, Route};
 pub use square::SquareLattice;
 

@@ -14,18 +14,20 @@
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
-pub mod analysis;
-pub mod capacity;
-pub mod closed_form;
-pub mod direct;
-pub mod model;
-pub mod reuse;
-pub mod solver;
-pub mod structure;
+pub(crate) mod analysis;
+pub(crate) mod capacity;
+pub(crate) mod closed_form;
+pub(crate) mod direct;
+pub(crate) mod model;
+pub(crate) mod reuse;
+pub(crate) mod solver;
+pub(crate) mod structure;
 
 pub use analysis::{Analysis, Analyzer, Critical, LinkResult, Verdict};
-pub use capacity::{ConnectorLoad, Mode, utilisation};
-pub use model::{Bending, Model};
+pub use capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};
+pub use direct::Factor;
+pub use model::{Bending, Capacity, Model};
+pub use solver::Vec6;
 pub use structure::{SceneRef, Structure};
 
 /// rapier's dynamic cross-check of the static analysis: test-only, so the

@@ -4,7 +4,7 @@
 //! is a set of events executed concurrently. See `docs/schedule-format.md`
 //! for the full description with examples.
 
-pub mod units;
+pub(crate) mod units;
 
 use crate::error::InputError;
 use crate::lattice::config::{Ground, ModuleId};

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use reconfcheck::certify::{self, Options, Report, ViolationKind};
-use reconfcheck::lattice::config::Ground;
+use reconfcheck::lattice::Ground;
 use reconfcheck::lattice::{Cell, LatticeKind};
 use reconfcheck::schedule::{Event, Length, ModuleSpec, Schedule, Step};
 
