@@ -24,6 +24,8 @@
 //! errors, validated numbers, progress reports. The library never prints,
 //! reads the environment or draws a progress bar: the binary does.
 
+#![cfg_attr(not(test), deny(clippy::print_stdout, clippy::print_stderr))]
+
 pub mod algorithms;
 pub mod certify;
 pub mod error;

@@ -213,6 +213,11 @@ pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError
 
 /// Certifies `schedule` with the given checks. Input errors (not a schedule
 /// this lattice can execute) abort; violations are collected in the report.
+///
+/// One pass replays the schedule with the lattice-level and other inline
+/// checks, stopping at a step that cannot be applied; the costly ranged
+/// checks then run over ranges of that pass in parallel, each range from
+/// the scene the pass recorded at its first step.
 pub fn certify_with(
     schedule: &Schedule,
     opts: &Options,
@@ -224,9 +229,35 @@ pub fn certify_with(
         .iter()
         .copied()
         .partition(|c| range > 0 && c.ranged());
-    // The scene at the first step of every range, taken in the one pass.
-    let mut starts: Vec<(usize, World)> = Vec::new();
-    let mut report = Report {
+    let mut report = empty_report(schedule, opts, checks);
+    let passes = if ranged.is_empty() { 1 } else { 2 };
+    let bar = &opts.progress;
+    bar.start("certifying", (passes * schedule.steps.len()) as u64);
+
+    // The initial configuration must stand on its own.
+    let loose = world.check_anchored();
+    if !loose.is_empty() {
+        report.violations.push(disconnected(0, "initial", loose));
+    }
+    let range_len = if ranged.is_empty() { 0 } else { range };
+    let starts = one_pass(&mut world, schedule, &inline, range_len, &mut report, bar)?;
+    if !ranged.is_empty() {
+        let last = report.per_step.len();
+        let outcomes = ranges_in_parallel(schedule, &ranged, &starts, range, last, bar)?;
+        merge(&mut report, outcomes);
+    }
+    bar.finish();
+
+    if report.stopped_at.is_none() {
+        final_checks(&mut world, schedule.steps.len() + 1, checks, &mut report);
+    }
+    report.certified = report.violations.is_empty() && report.stopped_at.is_none();
+    Ok(report)
+}
+
+/// A report with its header filled in and nothing found yet.
+fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) -> Report {
+    Report {
         format: report::REPORT_FORMAT.to_string(),
         version: 1,
         schedule: opts.name.clone(),
@@ -240,35 +271,44 @@ pub fn certify_with(
         violations: Vec::new(),
         warnings: Vec::new(),
         per_step: Vec::with_capacity(schedule.steps.len()),
-    };
-    let passes = if ranged.is_empty() { 1 } else { 2 };
-    let bar = &opts.progress;
-    bar.start("certifying", (passes * schedule.steps.len()) as u64);
-
-    // The initial configuration must stand on its own.
-    let loose = world.check_anchored();
-    if !loose.is_empty() {
-        report.violations.push(
-            Violation::new(
-                ViolationKind::Disconnected,
-                0,
-                format!(
-                    "the initial configuration has {} module(s) not connected to the ground",
-                    loose.len()
-                ),
-            )
-            .modules(loose),
-        );
     }
+}
 
+/// The violation of a configuration (`which`: initial or final) with
+/// modules not connected to the ground.
+fn disconnected(step: usize, which: &str, loose: Vec<crate::lattice::ModuleId>) -> Violation {
+    Violation::new(
+        ViolationKind::Disconnected,
+        step,
+        format!(
+            "the {which} configuration has {} module(s) not connected to the ground",
+            loose.len()
+        ),
+    )
+    .modules(loose)
+}
+
+/// Replays every step with the `inline` checks, recording each step's
+/// result in `report`, until a step cannot be applied (two modules ending
+/// in one cell). Returns the scene at the first step of every range of
+/// `range` steps (none when `range` is 0).
+fn one_pass(
+    world: &mut World,
+    schedule: &Schedule,
+    inline: &[&dyn StepCheck],
+    range: usize,
+    report: &mut Report,
+    bar: &Reporter,
+) -> Result<Vec<(usize, World)>, InputError> {
+    let mut starts = Vec::new();
     for k in 0..schedule.steps.len() {
         let index = k + 1;
-        if !ranged.is_empty() && k % range == 0 {
+        if range > 0 && k % range == 0 {
             starts.push((k, world.clone()));
         }
-        let (mut out, plan, clashes) = advance(&mut world, schedule, k, |ctx| {
+        let (mut out, plan, clashes) = advance(world, schedule, k, |ctx| {
             let mut out = StepOutcome::of_plan(ctx.plan);
-            for c in &inline {
+            for c in inline {
                 c.check(ctx, &mut out);
             }
             out
@@ -298,50 +338,46 @@ pub fn certify_with(
             break;
         }
     }
-    if !ranged.is_empty() {
-        let last = report.per_step.len();
-        let outcomes = ranges_in_parallel(schedule, &ranged, &starts, range, last, &bar)?;
-        for (k, out) in outcomes {
-            let r = &mut report.per_step[k];
-            r.violations += out.violations.len();
-            r.warnings += out.warnings.len();
-            r.metrics.extend(out.metrics);
-            report.violations.extend(out.violations);
-            report.warnings.extend(out.warnings);
-        }
-        // Back in step order, each step's own findings in check order.
-        report.violations.sort_by_key(|v| v.step);
-        report.warnings.sort_by_key(|v| v.step);
-    }
-    bar.finish();
+    Ok(starts)
+}
 
-    if report.stopped_at.is_none() {
-        let final_step = schedule.steps.len() + 1;
-        let loose = world.check_anchored();
-        if !loose.is_empty() {
-            report.violations.push(
-                Violation::new(
-                    ViolationKind::Disconnected,
-                    final_step,
-                    format!(
-                        "the final configuration has {} module(s) not connected to the ground",
-                        loose.len()
-                    ),
-                )
-                .modules(loose),
-            );
-        }
-        let mut out = StepOutcome::default();
-        for c in checks {
-            // A ranged check's own instance saw no step: it analyses the
-            // final scene from scratch.
-            c.check_final(&world, final_step, &mut out);
-        }
+/// Merges the ranged checks' findings (0-based step, outcome) into the
+/// report, then puts the findings back in step order, each step's own in
+/// check order.
+fn merge(report: &mut Report, outcomes: Vec<(usize, StepOutcome)>) {
+    for (k, out) in outcomes {
+        let r = &mut report.per_step[k];
+        r.violations += out.violations.len();
+        r.warnings += out.warnings.len();
+        r.metrics.extend(out.metrics);
         report.violations.extend(out.violations);
         report.warnings.extend(out.warnings);
     }
-    report.certified = report.violations.is_empty() && report.stopped_at.is_none();
-    Ok(report)
+    report.violations.sort_by_key(|v| v.step);
+    report.warnings.sort_by_key(|v| v.step);
+}
+
+/// The final configuration: connected, and whatever each check asks of it.
+fn final_checks(
+    world: &mut World,
+    final_step: usize,
+    checks: &[&dyn StepCheck],
+    report: &mut Report,
+) {
+    let loose = world.check_anchored();
+    if !loose.is_empty() {
+        report
+            .violations
+            .push(disconnected(final_step, "final", loose));
+    }
+    let mut out = StepOutcome::default();
+    for c in checks {
+        // A ranged check's own instance saw no step: it analyses the
+        // final scene from scratch.
+        c.check_final(world, final_step, &mut out);
+    }
+    report.violations.extend(out.violations);
+    report.warnings.extend(out.warnings);
 }
 
 /// Runs the `ranged` checks over the first `last` steps, one range of
