@@ -1,8 +1,10 @@
 //! Generators: algorithms that emit schedules of real moves.
 //!
 //! Each generator implements [`Generator`] and is listed in [`registry`];
-//! a scenario file names one by its [`Generator::name`]. Generators depend
-//! on the lattice and schedule layers only, never on certification.
+//! a scenario file names one by its [`Generator::name`]. Generators plan
+//! with the lattice, the schedule format and the geometry's motion rules;
+//! they never see the mechanics or certification (the layer list is in
+//! `src/lib.rs`): a generator implements its paper, the certifier judges.
 
 pub mod active_subtraction;
 pub mod branch;

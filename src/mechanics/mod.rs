@@ -1,5 +1,7 @@
 //! Mechanics (SPEC §4.5): gravity stability and connector loads of every
-//! intermediate structure, and the branch-length study.
+//! intermediate structure. It builds on the lattice only; certification
+//! runs it per step, and the branch-length study (`crate::study`) over many
+//! schedules.
 //!
 //! * [`model`] — the physical model (TOML in `models/`): mass, connector
 //!   capacity, ground contact;
