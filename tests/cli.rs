@@ -179,7 +179,11 @@ fn a_cell_beyond_the_coordinate_range_is_unusable_input() {
 
 #[test]
 fn a_spacing_that_is_not_a_positive_length_is_unusable_input() {
-    for (name, value) in [("zero.json", 0.0), ("negative.json", -3.6)] {
+    for (name, value) in [
+        ("zero.json", 0.0),
+        ("negative.json", -3.6),
+        ("subnormal.json", 1e-310),
+    ] {
         let mut s = walk();
         s["spacing"]["value"] = json!(value);
         assert_input_error(name, &s.to_string(), &["spacing", "not a positive length"]);

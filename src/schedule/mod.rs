@@ -176,11 +176,15 @@ impl Schedule {
 
     /// What a schedule must satisfy before it is replayed, whether read
     /// from a file or made by a generator: the format and version, a
-    /// positive finite spacing, and cells within [`MAX_COORDINATE`].
+    /// positive finite spacing (a normal number in metres), and cells within [`MAX_COORDINATE`].
     pub fn validate(&self) -> Result<(), InputError> {
         self.check_header()?;
-        let d = self.spacing.metres();
-        if !(d.is_finite() && d > 0.0) {
+        // In metres, after the unit's factor: a value that over- or
+        // underflows there (1e-320 mm) is no length either.
+        if crate::number::positive(self.spacing.value)
+            .and_then(|_| crate::number::positive(self.spacing.metres()))
+            .is_err()
+        {
             return Err(InputError::new(format!(
                 "spacing {} {} is not a positive length",
                 self.spacing.value,
