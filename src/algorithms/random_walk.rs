@@ -44,18 +44,19 @@ fn default_geometric() -> bool {
 
 /// The geometric move filter: a candidate rotation is taken when none of
 /// the cells its sweep penetrates or touches (derived motion rules,
-/// [`crate::geometry::rules::touched_cells`]) is occupied at the start of
-/// the step or claimed as a target by a move already chosen, and when its
-/// sweep keeps clear of every chosen move's sweep (exact mover–mover check).
+/// [`MotionRules::touched_cells`]) is occupied at the start of the step or
+/// claimed as a target by a move already chosen, and when its sweep keeps
+/// clear of every chosen move's sweep ([`MotionRules::concurrent_clear`]).
 /// Walks generated with it certify without collisions or sliding contacts.
 pub fn collision_free(config: &Configuration, m: &Motion, chosen: &[Motion]) -> bool {
+    let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
+        .expect("the FCC lattice has motion rules derived from the catom body");
     let claimed = |c: Cell| chosen.iter().any(|x| x.to() == c);
-    crate::geometry::rules::touched_cells(m)
+    rules
+        .touched_cells(m)
         .into_iter()
         .all(|c| config.is_free(c) && !claimed(c))
-        && chosen
-            .iter()
-            .all(|x| crate::geometry::fcc_sweep::rotations_clear(m, x))
+        && chosen.iter().all(|x| rules.concurrent_clear(m, x))
 }
 
 fn default_activity() -> f64 {

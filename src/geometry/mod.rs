@@ -137,6 +137,16 @@ pub trait MotionRules: Send + Sync {
     /// static modules. The pivot, the start and the target are not listed.
     fn blocking_cells(&self, motion: &Motion) -> Vec<crate::lattice::Cell>;
 
+    /// The cells whose occupant the move's sweep penetrates *or touches*
+    /// (blocking and sliding-contact cells, the target excluded): what a
+    /// planner that wants neither collisions nor sliding contact keeps
+    /// empty.
+    fn touched_cells(&self, motion: &Motion) -> Vec<crate::lattice::Cell>;
+
+    /// Whether two moves executed in the same step keep clear of each other
+    /// (sliding contact counts as not clear).
+    fn concurrent_clear(&self, a: &Motion, b: &Motion) -> bool;
+
     /// Whether `motion` is free of collisions with static modules, given
     /// which cells are occupied at the start of the step.
     fn allows(&self, motion: &Motion, occupied: &dyn Fn(crate::lattice::Cell) -> bool) -> bool {

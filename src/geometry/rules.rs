@@ -391,6 +391,14 @@ pub fn touched_cells(motion: &Motion) -> Vec<Cell> {
 pub struct FccRules;
 
 impl MotionRules for FccRules {
+    fn touched_cells(&self, motion: &Motion) -> Vec<Cell> {
+        touched_cells(motion)
+    }
+
+    fn concurrent_clear(&self, a: &Motion, b: &Motion) -> bool {
+        super::fcc_sweep::rotations_clear(a, b)
+    }
+
     fn blocking_cells(&self, motion: &Motion) -> Vec<Cell> {
         let Some(link) = Link::of_motion(&FccLattice, motion) else {
             return Vec::new();
