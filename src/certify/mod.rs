@@ -4,13 +4,17 @@
 //! Checks implement [`StepCheck`]; the lattice checks always run, geometric
 //! and mechanical checks join them where the lattice has a model for them.
 
+pub(crate) mod baseline;
 pub(crate) mod collision_check;
+pub(crate) mod junit;
 pub(crate) mod lattice_check;
 pub(crate) mod load_check;
 pub(crate) mod report;
 pub(crate) mod world;
 
+pub use baseline::{Comparison, Rise, compare as compare_with_baseline, load as load_baseline};
 pub use collision_check::CollisionCheck;
+pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
 pub use load_check::{LoadCheck, replay};
 pub use report::{Report, StepResult, Violation, ViolationKind};

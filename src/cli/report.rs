@@ -35,6 +35,19 @@ pub struct ReportArgs {
     /// check; overrides the schedule's own `model`.
     #[arg(long, value_name = "FILE")]
     model: Option<PathBuf>,
+    /// Also write the report as JUnit XML (one test case per check and
+    /// step), for CI systems.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// Compare with an earlier JSON report of the same schedule: exit 1
+    /// only for violations it did not have or for a utilisation that rose
+    /// by more than --baseline-tolerance; fixed ones are listed.
+    #[arg(long, value_name = "OLD.json")]
+    baseline: Option<PathBuf>,
+    /// The rise in utilisation (a fraction of capacity) a baseline
+    /// comparison still accepts.
+    #[arg(long, default_value_t = 1e-3, requires = "baseline")]
+    baseline_tolerance: f64,
 }
 
 impl ReportArgs {
@@ -60,15 +73,39 @@ impl ReportArgs {
 /// the report; the exit code says whether it was certified.
 pub fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<u8, Error> {
     let opts = args.options(origin)?;
+    let tolerance = reconfcheck::number::within(args.baseline_tolerance, 0.0, f64::MAX, "≥ 0")
+        .map_err(|e| InputError::new(format!("--baseline-tolerance: {e}")))?;
     let report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
+    // Read the baseline before writing anything: an unusable one is the
+    // input's error, and no half set of outputs is left behind.
+    let baseline = match &args.baseline {
+        Some(p) => Some(certify::load_baseline(
+            p,
+            &report,
+            &origin.display().to_string(),
+        )?),
+        None => None,
+    };
     let json = report.to_json();
     if let Some(p) = &args.json {
         write_file(p, &json)?;
+    }
+    if let Some(p) = &args.junit {
+        write_file(p, certify::to_junit(&report))?;
     }
     if args.print_json {
         println!("{json}");
     } else {
         print!("{}", report.summary());
     }
-    Ok(if report.certified { 0 } else { EXIT_VIOLATIONS })
+    match baseline {
+        Some(old) => {
+            let c = certify::compare_with_baseline(&report, &old, tolerance);
+            if !args.print_json {
+                print!("{}", c.summary());
+            }
+            Ok(if c.regressed() { EXIT_VIOLATIONS } else { 0 })
+        }
+        None => Ok(if report.certified { 0 } else { EXIT_VIOLATIONS }),
+    }
 }
