@@ -84,7 +84,7 @@ pub struct StepContext<'a> {
 }
 
 /// Findings of the checks on one step.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct StepOutcome {
     pub violations: Vec<Violation>,
     pub warnings: Vec<Violation>,
@@ -221,12 +221,24 @@ pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError
 ///
 /// One pass replays the schedule with the lattice-level and other inline
 /// checks, stopping at a step that cannot be applied; the costly ranged
-/// checks then run over ranges of that pass in parallel, each range from
-/// the scene the pass recorded at its first step.
+/// checks then run over ranges of that pass, each range from the scene the
+/// pass recorded at its first step, in parallel on this process's threads.
 pub fn certify_with(
     schedule: &Schedule,
     opts: &Options,
     checks: &[&dyn StepCheck],
+) -> Result<Report, InputError> {
+    certify_on(schedule, opts, checks, &Threads)
+}
+
+/// [`certify_with`], with the ranges run by `runner` (another process
+/// layout, e.g. MPI in the binary). Every runner gives the same report:
+/// the ranges and their order are the schedule's, not the runner's.
+pub fn certify_on(
+    schedule: &Schedule,
+    opts: &Options,
+    checks: &[&dyn StepCheck],
+    runner: &dyn RangeRunner,
 ) -> Result<Report, InputError> {
     let mut world = World::initial(schedule)?;
     let range = range_steps(opts, schedule.steps.len());
@@ -247,8 +259,16 @@ pub fn certify_with(
     let range_len = if ranged.is_empty() { 0 } else { range };
     let starts = one_pass(&mut world, schedule, &inline, range_len, &mut report, bar)?;
     if !ranged.is_empty() {
-        let last = report.per_step.len();
-        let outcomes = ranges_in_parallel(schedule, &ranged, &starts, range, last, bar)?;
+        let jobs = Ranges {
+            schedule,
+            checks: &ranged,
+            starts: &starts,
+            range,
+            last: report.per_step.len(),
+            bar,
+        };
+        let mut outcomes = runner.run(&jobs)?;
+        outcomes.sort_by_key(|(k, _)| *k);
         merge(&mut report, outcomes);
     }
     bar.finish();
@@ -258,6 +278,71 @@ pub fn certify_with(
     }
     report.certified = report.violations.is_empty() && report.stopped_at.is_none();
     Ok(report)
+}
+
+/// The ranged checks' work: ranges of consecutive steps, each independent
+/// of the others once the scene at its first step is known.
+pub struct Ranges<'a> {
+    schedule: &'a Schedule,
+    checks: &'a [&'a dyn StepCheck],
+    starts: &'a [(usize, World)],
+    range: usize,
+    last: usize,
+    bar: &'a Reporter,
+}
+
+impl Ranges<'_> {
+    /// How many ranges there are (some may lie past a stop and be empty).
+    pub fn count(&self) -> usize {
+        self.starts.len()
+    }
+
+    /// Runs range `i` (0-based): every step's findings, as (0-based step,
+    /// outcome), in step order.
+    pub fn run(&self, i: usize) -> Result<Vec<(usize, StepOutcome)>, InputError> {
+        let (first, start) = &self.starts[i];
+        let mut found = Vec::new();
+        if *first >= self.last {
+            return Ok(found);
+        }
+        let checks: Vec<Box<dyn StepCheck>> = self
+            .checks
+            .iter()
+            .map(|c| c.for_range().expect("a ranged check makes range instances"))
+            .collect();
+        let mut world = start.clone();
+        for k in *first..(first + self.range).min(self.last) {
+            let (out, _, _) = advance(&mut world, self.schedule, k, |ctx| {
+                let mut out = StepOutcome::default();
+                for c in &checks {
+                    c.check(ctx, &mut out);
+                }
+                out
+            })?;
+            found.push((k, out));
+            self.bar.advance(1);
+        }
+        Ok(found)
+    }
+}
+
+/// Runs [`Ranges`] somewhere and returns all their findings (any order).
+pub trait RangeRunner {
+    fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError>;
+}
+
+/// Runs the ranges on this process's threads (rayon).
+pub struct Threads;
+
+impl RangeRunner for Threads {
+    fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
+        use rayon::prelude::*;
+        let per_range: Vec<Vec<(usize, StepOutcome)>> = (0..ranges.count())
+            .into_par_iter()
+            .map(|i| ranges.run(i))
+            .collect::<Result<_, InputError>>()?;
+        Ok(per_range.into_iter().flatten().collect())
+    }
 }
 
 /// A report with its header filled in and nothing found yet.
@@ -385,44 +470,6 @@ fn final_checks(
     report.warnings.extend(out.warnings);
 }
 
-/// Runs the `ranged` checks over the first `last` steps, one range of
-/// `range` steps per scene in `starts`, in parallel; returns every step's
-/// findings (0-based step index), in step order.
-fn ranges_in_parallel(
-    schedule: &Schedule,
-    ranged: &[&dyn StepCheck],
-    starts: &[(usize, World)],
-    range: usize,
-    last: usize,
-    bar: &Reporter,
-) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-    use rayon::prelude::*;
-    let per_range: Vec<Vec<(usize, StepOutcome)>> = starts
-        .par_iter()
-        .filter(|(first, _)| *first < last)
-        .map(|(first, start)| {
-            let checks: Vec<Box<dyn StepCheck>> = ranged
-                .iter()
-                .map(|c| c.for_range().expect("a ranged check makes range instances"))
-                .collect();
-            let mut world = start.clone();
-            let mut found = Vec::new();
-            for k in *first..(first + range).min(last) {
-                let (out, _, _) = advance(&mut world, schedule, k, |ctx| {
-                    let mut out = StepOutcome::default();
-                    for c in &checks {
-                        c.check(ctx, &mut out);
-                    }
-                    out
-                })?;
-                found.push((k, out));
-                bar.advance(1);
-            }
-            Ok(found)
-        })
-        .collect::<Result<_, InputError>>()?;
-    Ok(per_range.into_iter().flatten().collect())
-}
 
 #[cfg(test)]
 mod tests {
