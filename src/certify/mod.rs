@@ -207,9 +207,18 @@ pub const MECHANICS_NOT_RUN: &str =
 
 /// Certifies `schedule` with every check that applies to it.
 pub fn certify(schedule: &Schedule, opts: &Options) -> Result<Report, InputError> {
+    certify_by(schedule, opts, &Threads)
+}
+
+/// [`certify`], with the ranged checks' ranges run by `runner`.
+pub fn certify_by(
+    schedule: &Schedule,
+    opts: &Options,
+    runner: &dyn RangeRunner,
+) -> Result<Report, InputError> {
     let checks = checks_for(schedule, opts)?;
     let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
-    let mut report = certify_with(schedule, opts, &refs)?;
+    let mut report = certify_on(schedule, opts, &refs, runner)?;
     if !opts.lattice_only && !checks.iter().any(|c| c.name() == load_check::NAME) {
         report.checks.push(MECHANICS_NOT_RUN.to_string());
     }
@@ -469,7 +478,6 @@ fn final_checks(
     report.violations.extend(out.violations);
     report.warnings.extend(out.warnings);
 }
-
 
 #[cfg(test)]
 mod tests {

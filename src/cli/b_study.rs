@@ -1,5 +1,6 @@
 //! `b-study`: the branch-length study over a range of b.
 
+use super::parallel;
 use reconfcheck::error::{Error, InputError, write_file};
 use reconfcheck::mechanics::{Bending, Model};
 use reconfcheck::number;
@@ -71,8 +72,34 @@ pub fn run(a: Args) -> Result<u8, Error> {
     }
     let generate = b_study::family(&a.family, m.spacing * 1e3, a.size, a.shape.as_deref())?;
     let lengths: Vec<usize> = (b_min..=b_max).collect();
-    let progress = super::progress::reporter(!a.no_progress, 1);
-    let st = b_study::b_study(&a.family, &m, &lengths, generate, &progress)?;
+    let progress = super::progress::reporter(!a.no_progress && parallel::is_root(), 1);
+    // Each process studies its share of the b values (all of them in one
+    // process); rank 0 assembles the study from every part.
+    let mine: Vec<usize> = parallel::my_share(lengths.len(), "branch lengths")?
+        .into_iter()
+        .map(|i| lengths[i])
+        .collect();
+    let part = b_study::study_rows(&m, &mine, generate, &progress);
+    let (rows, unplanned, first_error) = match part {
+        Ok((rows, unplanned, first)) => (Ok(rows), Ok(unplanned), first),
+        Err(e) => (Err(e.clone()), Err(e), None),
+    };
+    let rows = parallel::gather(rows)?;
+    let unplanned = parallel::gather(unplanned)?;
+    if !parallel::is_root() {
+        return Ok(0);
+    }
+    if rows.is_empty() {
+        return Err(first_error
+            .unwrap_or_else(|| {
+                let why = unplanned
+                    .first()
+                    .map_or("no b given", |u| u.reason.as_str());
+                InputError::new(format!("no branch length could be planned: {why}"))
+            })
+            .into());
+    }
+    let st = b_study::assemble(&a.family, &m, rows, unplanned);
     print!("{}", st.table());
     #[cfg(feature = "render")]
     if let Some(p) = &a.plot {

@@ -58,7 +58,10 @@ impl ReportArgs {
             Tolerance::new(self.epsilon).map_err(|e| InputError::new(format!("--epsilon: {e}")))?;
         Ok(Options {
             name: origin.display().to_string(),
-            progress: super::progress::reporter(!self.no_progress, 50),
+            progress: super::progress::reporter(
+                !self.no_progress && super::parallel::is_root(),
+                50,
+            ),
             exact: self.exact,
             epsilon,
             lattice_only: self.lattice_only,
@@ -75,7 +78,12 @@ pub fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Res
     let opts = args.options(origin)?;
     let tolerance = reconfcheck::number::within(args.baseline_tolerance, 0.0, f64::MAX, "≥ 0")
         .map_err(|e| InputError::new(format!("--baseline-tolerance: {e}")))?;
-    let report = certify::certify(s, &opts).map_err(|e| e.in_file(origin))?;
+    let report = certify::certify_by(s, &opts, super::parallel::runner().as_ref())
+        .map_err(|e| e.in_file(origin))?;
+    if !super::parallel::is_root() {
+        // Another process gathered this one's part and writes the report.
+        return Ok(0);
+    }
     // Read the baseline before writing anything: an unusable one is the
     // input's error, and no half set of outputs is left behind.
     let baseline = match &args.baseline {

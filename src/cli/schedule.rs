@@ -54,7 +54,9 @@ pub fn generate(a: GenerateArgs) -> Result<u8, Error> {
 pub fn run(a: RunArgs) -> Result<u8, Error> {
     let path = a.scenario.unwrap_or_else(Scenario::default_path);
     let sc = Scenario::load(&path)?;
-    eprintln!("scenario {}: {}", sc.name, sc.description);
+    if super::parallel::is_root() {
+        eprintln!("scenario {}: {}", sc.name, sc.description);
+    }
     let s = algorithms::generate(&sc)?;
     if let Some(out) = &a.output {
         save(&sc, s.clone(), out)?;

@@ -23,7 +23,7 @@ use serde::Serialize;
 use std::path::Path;
 
 /// Results for one branch length.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct Row {
     pub b: usize,
     pub steps: usize,
@@ -71,7 +71,7 @@ pub struct SweepRow {
 }
 
 /// A branch length the family's generator could not plan.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct Unplanned {
     pub b: usize,
     /// The generator's error.
@@ -202,6 +202,23 @@ pub fn b_study(
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
 ) -> Result<Study, InputError> {
+    let (rows, unplanned, first_error) = study_rows(model, lengths, generate, progress)?;
+    if let (true, Some(e)) = (rows.is_empty(), first_error) {
+        return Err(e);
+    }
+    Ok(assemble(family, model, rows, unplanned))
+}
+
+/// The rows of the b values in `lengths`, each from checking every step of
+/// its schedule; the b values the generator could not plan, and the first
+/// such error. Each b is independent of the others: a study may be split
+/// over processes by b and [`assemble`]d from the parts.
+pub fn study_rows(
+    model: &Model,
+    lengths: &[usize],
+    generate: impl Fn(usize) -> Result<Schedule, InputError>,
+    progress: &Reporter,
+) -> Result<(Vec<Row>, Vec<Unplanned>, Option<InputError>), InputError> {
     let mut rows = Vec::new();
     let mut unplanned = Vec::new();
     let mut first_error = None;
@@ -295,9 +312,19 @@ pub fn b_study(
         }
         rows.push(row);
     }
-    if let (true, Some(e)) = (rows.is_empty(), first_error) {
-        return Err(e);
-    }
+    Ok((rows, unplanned, first_error))
+}
+
+/// The study of `family` from its rows (any order) and its unplanned b
+/// values: the largest safe b, the pressure sweep and the closed forms.
+pub fn assemble(
+    family: &str,
+    model: &Model,
+    mut rows: Vec<Row>,
+    mut unplanned: Vec<Unplanned>,
+) -> Study {
+    rows.sort_by_key(|r| r.b);
+    unplanned.sort_by_key(|u| u.b);
     let prefix_max = |ok: &dyn Fn(&Row) -> bool| {
         let mut best = 0;
         let mut sorted: Vec<&Row> = rows.iter().collect();
@@ -333,7 +360,7 @@ pub fn b_study(
             }
         })
         .collect();
-    Ok(Study {
+    Study {
         family: family.to_string(),
         model: model.name.clone(),
         pressure_kpa: model.connector.pressure / 1e3,
@@ -343,7 +370,7 @@ pub fn b_study(
         b_max,
         closed_b_max: closed_form::cantilever_max_length(model, true),
         sweep,
-    })
+    }
 }
 
 impl Study {

@@ -1,0 +1,97 @@
+//! Certification and the b-study split over MPI processes give the report
+//! of one process, byte for byte (built with the `mpi` feature; Open MPI's
+//! `mpirun` on localhost). Without the feature, an MPI launch is refused
+//! with a clear message instead of every process doing all the work.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_reconfcheck")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reconfcheck-mpi-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[cfg(feature = "mpi")]
+fn mpirun(n: usize, args: &[&str]) -> Output {
+    Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-n", &n.to_string(), bin()])
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("mpirun (Open MPI) is installed: .ci/setup installs it")
+}
+
+fn alone(args: &[&str]) -> Output {
+    Command::new(bin())
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn two_processes_certify_to_the_same_report_as_one() {
+    let (one, two) = (scratch("one.json"), scratch("two.json"));
+    let a = alone(&["run", "--no-progress", "--json", one.to_str().unwrap()]);
+    let b = mpirun(2, &["run", "--no-progress", "--json", two.to_str().unwrap()]);
+    assert_eq!(a.status.code(), Some(0));
+    assert_eq!(b.status.code(), Some(0), "{}", String::from_utf8_lossy(&b.stderr));
+    let report = std::fs::read(&one).unwrap();
+    assert!(String::from_utf8_lossy(&report).contains("max_utilisation"), "mechanics ran");
+    assert!(report == std::fs::read(&two).unwrap(), "the reports differ");
+    assert_eq!(a.stdout, b.stdout, "one summary, printed by rank 0 only");
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn two_processes_study_the_same_branch_lengths_as_one() {
+    let (one, two) = (scratch("b1.json"), scratch("b2.json"));
+    let args = |p: &PathBuf| {
+        vec![
+            "b-study".to_string(),
+            "--family=pyramid".into(),
+            "--size=2".into(),
+            "--b-min=4".into(),
+            "--b-max=6".into(),
+            "--no-progress".into(),
+            format!("--json={}", p.display()),
+        ]
+    };
+    let a1 = args(&one);
+    let a2 = args(&two);
+    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
+    let b = mpirun(2, &a2.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(b.status.code(), Some(0), "{}", String::from_utf8_lossy(&b.stderr));
+    assert_eq!(a.stdout, b.stdout);
+    assert!(std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap());
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn more_processes_than_work_is_refused_not_a_hang() {
+    let b = mpirun(3, &["b-study", "--family=branch", "--b-min=1", "--b-max=2", "--no-progress"]);
+    assert_eq!(b.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&b.stderr);
+    assert!(err.contains("3 processes for 2 branch lengths"), "{err}");
+}
+
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn an_mpi_launch_without_the_feature_is_refused_with_a_clear_message() {
+    let o = Command::new(bin())
+        .args(["run", "--no-progress"])
+        .env("OMPI_COMM_WORLD_SIZE", "2")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("without the `mpi` feature"), "{err}");
+    assert!(o.stdout.is_empty(), "no process does the work");
+}
