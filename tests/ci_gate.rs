@@ -4,33 +4,20 @@
 use proptest::prelude::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
-}
+mod common;
+
+use common::bin;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-ci-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("ci", name)
 }
 
-/// The bundled walk's first step, optionally with a fixed module at
-/// (1, −1, 1) that the first rotation cuts 0.28 d deep.
+/// The walk with (or without) the obstacle its first rotation cuts.
 fn walk(name: &str, obstacle: bool) -> PathBuf {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"),
-    )
-    .unwrap();
-    let mut s: Value = serde_json::from_str(&text).unwrap();
-    s["steps"].as_array_mut().unwrap().truncate(1);
-    let modules = s["modules"].as_array_mut().unwrap();
-    // Same module count either way: the obstacle, or a harmless module.
-    let cell = if obstacle { [1, -1, 1] } else { [9, 9, 0] };
-    modules.push(serde_json::json!({"id": 900, "cell": cell, "fixed": true}));
     let p = scratch(name);
-    std::fs::write(&p, s.to_string()).unwrap();
+    common::walk_with_obstacle(&p, obstacle);
     p
 }
 

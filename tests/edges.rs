@@ -5,33 +5,20 @@
 
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
-}
+mod common;
+
+use common::{bin, walk_with_obstacle};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-edges-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("edges", name)
 }
 
-/// The bundled walk's first step, with a fixed module at (1, −1, 1) that
-/// the first rotation (0,0,1) → (1,0,1) about (1,0,0) cuts 0.28 d deep.
+/// The penetrating walk (see [`walk_with_obstacle`]), one file per `tag`.
 fn penetrating_schedule(tag: &str) -> PathBuf {
-    let text = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"),
-    )
-    .unwrap();
-    let mut s: Value = serde_json::from_str(&text).unwrap();
-    s["steps"].as_array_mut().unwrap().truncate(1);
-    s["modules"]
-        .as_array_mut()
-        .unwrap()
-        .push(serde_json::json!({"id": 900, "cell": [1, -1, 1], "fixed": true}));
     let p = scratch(&format!("penetrating-{tag}.json"));
-    std::fs::write(&p, s.to_string()).unwrap();
+    walk_with_obstacle(&p, true);
     p
 }
 

@@ -19,7 +19,13 @@ fn scratch(name: &str) -> PathBuf {
 #[cfg(feature = "mpi")]
 fn mpirun(n: usize, args: &[&str]) -> Output {
     Command::new("mpirun")
-        .args(["--allow-run-as-root", "--oversubscribe", "-n", &n.to_string(), bin()])
+        .args([
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-n",
+            &n.to_string(),
+            bin(),
+        ])
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
@@ -39,11 +45,22 @@ fn alone(args: &[&str]) -> Output {
 fn two_processes_certify_to_the_same_report_as_one() {
     let (one, two) = (scratch("one.json"), scratch("two.json"));
     let a = alone(&["run", "--no-progress", "--json", one.to_str().unwrap()]);
-    let b = mpirun(2, &["run", "--no-progress", "--json", two.to_str().unwrap()]);
+    let b = mpirun(
+        2,
+        &["run", "--no-progress", "--json", two.to_str().unwrap()],
+    );
     assert_eq!(a.status.code(), Some(0));
-    assert_eq!(b.status.code(), Some(0), "{}", String::from_utf8_lossy(&b.stderr));
+    assert_eq!(
+        b.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
     let report = std::fs::read(&one).unwrap();
-    assert!(String::from_utf8_lossy(&report).contains("max_utilisation"), "mechanics ran");
+    assert!(
+        String::from_utf8_lossy(&report).contains("max_utilisation"),
+        "mechanics ran"
+    );
     assert!(report == std::fs::read(&two).unwrap(), "the reports differ");
     assert_eq!(a.stdout, b.stdout, "one summary, printed by rank 0 only");
 }
@@ -67,7 +84,12 @@ fn two_processes_study_the_same_branch_lengths_as_one() {
     let a2 = args(&two);
     let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
     let b = mpirun(2, &a2.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(b.status.code(), Some(0), "{}", String::from_utf8_lossy(&b.stderr));
+    assert_eq!(
+        b.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
     assert_eq!(a.stdout, b.stdout);
     assert!(std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap());
 }
@@ -75,7 +97,16 @@ fn two_processes_study_the_same_branch_lengths_as_one() {
 #[cfg(feature = "mpi")]
 #[test]
 fn more_processes_than_work_is_refused_not_a_hang() {
-    let b = mpirun(3, &["b-study", "--family=branch", "--b-min=1", "--b-max=2", "--no-progress"]);
+    let b = mpirun(
+        3,
+        &[
+            "b-study",
+            "--family=branch",
+            "--b-min=1",
+            "--b-max=2",
+            "--no-progress",
+        ],
+    );
     assert_eq!(b.status.code(), Some(2));
     let err = String::from_utf8_lossy(&b.stderr);
     assert!(err.contains("3 processes for 2 branch lengths"), "{err}");

@@ -4,9 +4,9 @@
 //! gather them on rank 0, which alone writes and prints. The report is the
 //! same bytes either way: ranges and their order are the schedule's.
 
+use reconfcheck::certify::{RangeRunner, Threads};
 #[cfg(feature = "mpi")]
 use reconfcheck::certify::{Ranges, StepOutcome};
-use reconfcheck::certify::{RangeRunner, Threads};
 use reconfcheck::error::{Error, InputError};
 use std::sync::OnceLock;
 

@@ -53,3 +53,35 @@ pub fn lattice_report(s: &Schedule) -> Report {
 pub fn kinds(r: &Report) -> Vec<(ViolationKind, usize)> {
     r.violations.iter().map(|v| (v.kind, v.step)).collect()
 }
+
+/// The `reconfcheck` binary of this build.
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+}
+
+/// A path `name` in a scratch folder of this test process (`tag` keeps
+/// test files apart).
+pub fn scratch(tag: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("reconfcheck-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// The bundled walk's first step, written to `path`, plus a fixed module
+/// 900: at (1, −1, 1), where the first rotation (0,0,1) → (1,0,1) about
+/// (1,0,0) cuts it 0.28 d deep, or (`obstacle` false) out of the way at
+/// (9, 9, 0), which keeps the module count.
+pub fn walk_with_obstacle(path: &std::path::Path, obstacle: bool) {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"),
+    )
+    .unwrap();
+    let mut s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    s["steps"].as_array_mut().unwrap().truncate(1);
+    let cell = if obstacle { [1, -1, 1] } else { [9, 9, 0] };
+    s["modules"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"id": 900, "cell": cell, "fixed": true}));
+    std::fs::write(path, s.to_string()).unwrap();
+}
