@@ -231,6 +231,7 @@ pub fn certify_with(
         schedule: opts.name.clone(),
         lattice: schedule.lattice,
         modules: schedule.modules.len(),
+        final_modules: schedule.final_module_count(),
         steps: schedule.steps.len(),
         moves: schedule.move_count(),
         checks: checks.iter().map(|c| c.name().to_string()).collect(),

@@ -21,6 +21,7 @@
 //! This replaces the paper's hand-written local rules and green-light
 //! handshake by a search that imposes the same invariants.
 
+use super::paper::Protocol;
 use super::scaffold::Scaffold;
 use super::shape::Skew;
 use crate::error::InputError;
@@ -66,6 +67,7 @@ pub struct Hop {
 /// reservations of every module planned so far.
 pub struct Planner<'a> {
     rules: &'a dyn MotionRules,
+    protocol: Protocol,
     table: [[&'static [Route]; 12]; 12],
     /// Cells holding a static module once everything planned is in place.
     occupied: FxHashSet<Cell>,
@@ -98,7 +100,7 @@ pub struct Planner<'a> {
 
 impl<'a> Planner<'a> {
     /// A planner over `scaffold`'s sandbox (module ids `0..sandbox.len()`).
-    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules) -> Planner<'a> {
+    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules, protocol: Protocol) -> Planner<'a> {
         let mut occupied = FxHashSet::default();
         let mut module_at = FxHashMap::default();
         for (i, s) in scaffold.sandbox.iter().enumerate() {
@@ -113,6 +115,7 @@ impl<'a> Planner<'a> {
         }
         Planner {
             rules,
+            protocol,
             table: rotation_table(),
             occupied,
             module_at,
@@ -245,6 +248,12 @@ impl<'a> Planner<'a> {
         if p.is_empty() {
             return true;
         }
+        if self.protocol == Protocol::Paper {
+            // The paper keeps free agents apart through the light pivots
+            // only ([`Self::light_is_green`]): a cell is clear when no
+            // agent holds it.
+            return !p.contains_key(&c);
+        }
         let l = FccLattice;
         !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
     }
@@ -280,6 +289,38 @@ impl<'a> Planner<'a> {
                 .blocking_cells(m)
                 .into_iter()
                 .all(|b| !self.swept[step].contains(&b))
+    }
+
+    /// The *light pivot* of a rotation to `to` (§3.3.4): among the static
+    /// modules `to` will touch, the one further along the path — nearest
+    /// to `aim` (the next cell of the route, or `to` itself on the last
+    /// hop), the rotation's pivot only when it is the sole neighbour.
+    fn light_pivot(&self, to: Cell, pivot: Cell, aim: Cell, step: usize) -> Cell {
+        let l = FccLattice;
+        let a = l.centre(aim);
+        (0..12)
+            .map(|k| l.neighbour(to, k))
+            .filter(|&q| q != pivot && self.module_at.get(&q).is_some_and(|&(_, at)| at < step))
+            .min_by(|&p, &q| {
+                let (dp, dq) = ((l.centre(p) - a).length(), (l.centre(q) - a).length());
+                dp.total_cmp(&dq)
+                    .then((p.x, p.y, p.z).cmp(&(q.x, q.y, q.z)))
+            })
+            .unwrap_or(pivot)
+    }
+
+    /// Whether light pivot `lp` is green at the end of step `t`: no free
+    /// agent on any of its connectors. An agent standing on its final
+    /// cell has sent FINAL-TARGET-REACHED and no longer counts.
+    fn light_is_green(&self, lp: Cell, t: usize) -> bool {
+        if t >= self.positions.len() {
+            return true;
+        }
+        let l = FccLattice;
+        let p = &self.positions[t];
+        (0..12)
+            .map(|k| l.neighbour(lp, k))
+            .all(|q| !p.contains_key(&q) || self.module_at.get(&q).is_some_and(|&(_, at)| at <= t))
     }
 
     fn free_of_agents(&self, c: Cell, t: usize) -> bool {
@@ -330,6 +371,14 @@ impl<'a> Planner<'a> {
                             || !self.free_of_agents(q, step)
                     };
                     ok = self.rules.allows(&m, &occ) && self.sweep_is_free(&m, step);
+                    if ok && self.protocol == Protocol::Paper {
+                        // PROBE-LIGHT-STATE / GREEN-LIGHT-ON: the move
+                        // waits while its light pivot is red or orange
+                        // (another free agent on it), before or after.
+                        let aim = hops.get(i + 1).map_or(hop.to, |h| h.to);
+                        let lp = self.light_pivot(hop.to, hop.pivot, aim, step);
+                        ok = self.light_is_green(lp, t) && self.light_is_green(lp, step);
+                    }
                 }
                 if ok && last {
                     // Once in place, the module must not stand in the way

@@ -196,28 +196,37 @@ impl Scaffold {
         // The scene is the half-space z ≥ 0 above the sandbox: parts of a
         // shape below the ground (a sphere's lower half) are not built.
         let is_tile = |r: Skew| tiles.contains_key(&r);
+        // A branch from tile `r` along `d` is complete when all its b − 1
+        // cells are in the shape. Where a concavity cuts it, the authors'
+        // implementation grows it up to the first cell outside and no
+        // longer counts it as an ingoing branch of the tile it would reach
+        // (VisibleSim scaffolding_csg); so does this one.
+        let complete =
+            |r: Skew, d: Dir| (1..bi).all(|m| shape.contains(r.offset(d.step().scale(m))));
         let roots: Vec<Skew> = tiles.keys().copied().collect();
         let mut info: BTreeMap<Skew, Tile> = BTreeMap::new();
         for &r in &roots {
             let mut t = tiles[&r].clone();
             for u in Dir::UPWARD {
                 let from = r.offset(u.step().scale(-bi));
-                if t.layer == 0 || is_tile(from) {
+                if t.layer == 0 || (is_tile(from) && complete(from, u)) {
                     t.ingoing_up.push(u);
                 }
             }
             if t.ingoing_up.is_empty() {
                 return Err(InputError::new(format!(
-                    "tile root {:?} (tile layer {}) of {} has no tile under it to feed it: the shape \
-                     overhangs. Seed 000 §5 builds semi-convex shapes only (no layer wider than the \
-                     layer below it, as seen from the sandbox); §6's downward growth is not implemented",
+                    "tile root {:?} (tile layer {}) of {} has no tile under it to feed it through a \
+                     complete upward branch: the shape overhangs. Seed 000 §5 builds semi-convex shapes \
+                     only (no layer wider than the layer below it, as seen from the sandbox); §6's \
+                     downward growth is not implemented",
                     (r.x, r.y, r.z),
                     t.layer,
                     shape.describe()
                 )));
             }
             for h in [Dir::X, Dir::Y] {
-                if is_tile(r.offset(h.step().scale(-bi))) {
+                let from = r.offset(h.step().scale(-bi));
+                if is_tile(from) && complete(from, h) {
                     t.ingoing_h.push(h);
                 }
             }
@@ -239,16 +248,6 @@ impl Scaffold {
                 let mut len = 0;
                 while len < bi - 1 && shape.contains(r.offset(d.step().scale(len + 1))) {
                     len += 1;
-                }
-                if is_tile(far) && len < bi - 1 {
-                    return Err(InputError::new(format!(
-                        "the {} branch between tile roots {:?} and {:?} of {} leaves the shape: a concavity \
-                         between two tiles; seed 000 §5 builds semi-convex shapes only",
-                        d.name(),
-                        (r.x, r.y, r.z),
-                        (far.x, far.y, far.z),
-                        shape.describe()
-                    )));
                 }
                 if len == 0 {
                     continue;
