@@ -6,20 +6,24 @@
 //! precedences), with prioritised space–time planning:
 //!
 //! 1. a static route is searched (A*) over the structure the earlier
-//!    modules leave behind, with every rotation accepted by the lattice's
-//!    geometry-derived [`MotionRules`] (blocking cells empty);
+//!    modules leave behind, with every rotation accepted by the
+//!    [`MotionRules`] of the protocol: the rules derived from the exact
+//!    catom body (safe), or the paper's bridging constraint (paper);
 //! 2. the module then follows that route in time against the trajectories
-//!    of the modules already planned: it waits while a pivot is not yet in
-//!    place, while its component's predecessors are not yet in place, or
-//!    while moving would break the gap that §3.3.4's light protocol keeps
-//!    between free agents (no two free agents in neighbouring cells, before
-//!    or after any step, and nobody inside another mover's blocking cells);
+//!    of the modules already planned, which move concurrently with it: it
+//!    waits while a pivot or a predecessor component is not yet in place,
+//!    while the next cell is held or swept by another agent, while the
+//!    rotation is disallowed with the other agents (before and after the
+//!    step) counted as obstacles or would sweep a cell another rotation of
+//!    the step sweeps, and — in the paper's protocol — while its light
+//!    pivot is red or orange (§3.3.4);
 //! 3. if waiting is impossible (another module comes by), its departure
 //!    is delayed by one step and it tries again. Departing after every
 //!    earlier module has arrived always succeeds, so planning terminates.
 //!
-//! This replaces the paper's hand-written local rules and green-light
-//! handshake by a search that imposes the same invariants.
+//! The safe protocol asks exactly what the swept cells require: no gap
+//! between free agents beyond that (an earlier version kept free agents
+//! out of neighbouring cells, 13–25 % slower, see docs/scaffold.md).
 
 use super::paper::Protocol;
 use super::scaffold::Scaffold;
@@ -237,25 +241,14 @@ impl<'a> Planner<'a> {
         None
     }
 
+    /// Whether cell `c` is free at the end of step `t`: no free agent
+    /// holds it and no rotation of that step sweeps it. That is all the
+    /// geometry asks of the cells themselves; the rest is checked per
+    /// move (the rules with the agents as obstacles, disjoint sweeps) and,
+    /// in the paper's protocol, by the light pivots.
     fn clear(&self, c: Cell, t: usize) -> bool {
-        if t >= self.positions.len() {
-            return true;
-        }
-        if self.swept[t].contains(&c) {
-            return false;
-        }
-        let p = &self.positions[t];
-        if p.is_empty() {
-            return true;
-        }
-        if self.protocol == Protocol::Paper {
-            // The paper keeps free agents apart through the light pivots
-            // only ([`Self::light_is_green`]): a cell is clear when no
-            // agent holds it.
-            return !p.contains_key(&c);
-        }
-        let l = FccLattice;
-        !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
+        t >= self.positions.len()
+            || (!self.swept[t].contains(&c) && !self.positions[t].contains_key(&c))
     }
 
     /// Whether a module arriving at `c` at the end of `step` leaves every
