@@ -456,9 +456,9 @@ fn the_papers_protocol_is_faster_than_the_safe_one_and_near_equation_6() {
 
 /// Item 3 of the issue: the paper's protocol, replayed with the exact
 /// catom body, makes moves the body forbids. Each is listed with its step,
-/// modules, depth and witness points; the 2-pyramid has 106.
+/// modules, depth and witness points; the 2-pyramid has 13.
 #[test]
-fn the_papers_protocol_collides_106_times_on_the_2_pyramid() {
+fn the_papers_protocol_collides_13_times_on_the_2_pyramid() {
     use reconfcheck::algorithms::scaffold::paper::Protocol;
     use reconfcheck::certify::ViolationKind;
     let s = scaffold_schedule_with(&ShapeSpec::Pyramid { h: 2 }, 6, Protocol::Paper).unwrap();
@@ -469,7 +469,7 @@ fn the_papers_protocol_collides_106_times_on_the_2_pyramid() {
         .iter()
         .filter(|v| v.kind == ViolationKind::Collision)
         .collect();
-    assert_eq!(collisions.len(), 106, "{}", r.summary());
+    assert_eq!(collisions.len(), 13, "{}", r.summary());
     assert!(
         r.violations.iter().all(|v| !v.kind.is_lattice_level()),
         "the paper's moves are lattice-legal: {}",

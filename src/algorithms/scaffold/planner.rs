@@ -220,7 +220,15 @@ impl<'a> Planner<'a> {
                     if best.get(&to).is_some_and(|&(bg, _)| bg <= ng) {
                         continue;
                     }
-                    let Some(&route) = routes.iter().find(|&&route| {
+                    // The paper's model allows both routes of a 60° link;
+                    // its catoms take the hexagonal one (the shorter
+                    // actuator path, §3 Fig. 1b). The safe protocol takes
+                    // the first the body allows.
+                    let mut order = routes.to_vec();
+                    if self.protocol == Protocol::Paper {
+                        order.reverse();
+                    }
+                    let Some(&route) = order.iter().find(|&&route| {
                         self.rules.allows(
                             &Motion::Rotate {
                                 from: c,
