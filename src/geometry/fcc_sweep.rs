@@ -366,7 +366,7 @@ mod tests {
             let from = l.neighbour(pivot, lk.from as usize);
             let to = l.neighbour(pivot, lk.to as usize);
             let slides: Vec<Cell> = offsets_within_reach()
-                .into_iter()
+                .iter()
                 .map(|o| o.from(pivot))
                 .filter(|&c| c != pivot && c != from && c != to)
                 .filter(|&c| {
