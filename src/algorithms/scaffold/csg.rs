@@ -502,6 +502,36 @@ mod tests {
         assert!(h.root.contains(DVec3::new(-1.0, -1.0, -1.0)));
     }
 
+    /// The domed cube's knife edge: a branch cell 0.0037 d outside a dome
+    /// of radius 10 is a cell of the shape; 0.1 d outside is not. A
+    /// subtracted solid is shrunk by the tolerance, so a cell 0.01 d inside
+    /// a hole's wall is kept, and one 0.1 d inside it is removed.
+    #[test]
+    fn membership_has_a_stated_tolerance_of_a_twentieth_of_d() {
+        assert_eq!(MEMBERSHIP_TOL, 0.05);
+        let dome = Node::Sphere { r: 10.0 };
+        assert!(dome.contains(DVec3::new(10.0037, 0.0, 0.0)));
+        assert!(!dome.contains(DVec3::new(10.1, 0.0, 0.0)));
+        let holed = Node::Difference(vec![
+            Node::Cube {
+                size: DVec3::splat(10.0),
+                center: false,
+            },
+            Node::Translate {
+                v: DVec3::new(5.0, 5.0, 0.0),
+                child: Box::new(Node::Cylinder {
+                    h: 10.0,
+                    r: 2.0,
+                    center: false,
+                }),
+            },
+        ]);
+        assert!(holed.contains(DVec3::new(5.0 + 1.99, 5.0, 1.0)));
+        assert!(!holed.contains(DVec3::new(5.0 + 1.9, 5.0, 1.0)));
+        assert!(holed.contains(DVec3::new(10.03, 1.0, 1.0)));
+        assert!(!holed.contains(DVec3::new(f64::NAN, 1.0, 1.0)));
+    }
+
     #[test]
     fn unsupported_operations_are_named_with_their_line() {
         let e = CsgShape::parse("r", "cube(3);\nrotate([0,0,45]) cube(2);").unwrap_err();
