@@ -488,10 +488,13 @@ fn the_papers_protocol_collides_13_times_on_the_2_pyramid() {
 /// from a cube to a cylinder) and the domed cube (a branch cell 0.0037 d
 /// outside the dome) are built, as their implementation builds them.
 #[test]
-fn the_authors_plated_sandcastle_and_domed_cube_are_accepted() {
+fn the_authors_plated_sandcastle_and_domed_cube_are_accepted_and_the_bowled_cube_refused() {
     use reconfcheck::algorithms::scaffold::build_scaffold;
     for (name, modules) in [("sandcastle-plate.csg", 41_138), ("domed-cube.csg", 2395)] {
         let s = build_scaffold(&shape(name), 6).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(s.module_count(), modules, "{name}");
     }
+    // Their bowled cube stays outside the class: its rim overhangs.
+    let e = build_scaffold(&shape("bowled-cube.csg"), 6).unwrap_err();
+    assert!(e.message.contains("overhangs"), "{}", e.message);
 }
