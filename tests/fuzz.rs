@@ -282,6 +282,10 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
         ("scaffold", "shape = \"pyramid\"\nh = 1\nb = 4"),
         ("scaffold", "shape = \"cube\"\nh = 1\ne = 2\nb = 4"),
         (
+            "scaffold",
+            "shape = \"pyramid\"\nh = 1\nb = 4\nprotocol = \"paper\"",
+        ),
+        (
             "active-subtraction",
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),
@@ -328,7 +332,7 @@ proptest! {
     /// the scenario or a file, or generated and certified; never a panic.
     #[test]
     fn edited_scenario_parameters_are_refused_or_run_never_a_panic(
-        base in 0usize..6,
+        base in 0usize..scenario_bases().len(),
         edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..21), 1..3),
     ) {
         use reconfcheck::scenario::Scenario;

@@ -362,6 +362,7 @@ fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) 
         schedule: opts.name.clone(),
         lattice: schedule.lattice,
         modules: schedule.modules.len(),
+        final_modules: schedule.final_module_count(),
         steps: schedule.steps.len(),
         moves: schedule.move_count(),
         checks: checks.iter().map(|c| c.name().to_string()).collect(),

@@ -127,7 +127,12 @@ pub struct Report {
     pub version: u32,
     pub schedule: String,
     pub lattice: LatticeKind,
+    /// Modules in the initial configuration.
     pub modules: usize,
+    /// Modules at the end (initial + entered − left): a scaffold run starts
+    /// with its sandbox and ends with sandbox and shape.
+    #[serde(default)]
+    pub final_modules: usize,
     pub steps: usize,
     pub moves: usize,
     /// Names of the checks that were run.
@@ -168,10 +173,11 @@ impl Report {
         };
         let _ = writeln!(
             s,
-            "{verdict}: {} ({} lattice, {} modules, {} steps, {} moves)",
+            "{verdict}: {} ({} lattice, {} modules at the start, {} at the end, {} steps, {} moves)",
             self.schedule,
             self.lattice.name(),
             self.modules,
+            self.final_modules,
             self.steps,
             self.moves
         );
@@ -242,6 +248,7 @@ mod tests {
             schedule: "s.json".into(),
             lattice: LatticeKind::Fcc,
             modules: 3,
+            final_modules: 5,
             steps: 9,
             moves: 9,
             checks: vec!["lattice".into()],
@@ -251,6 +258,12 @@ mod tests {
             warnings,
             per_step: Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_summary_names_the_module_count_at_the_start_and_at_the_end() {
+        let s = report(Vec::new(), Vec::new()).summary();
+        assert!(s.contains("3 modules at the start, 5 at the end"), "{s}");
     }
 
     #[test]

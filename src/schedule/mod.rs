@@ -155,6 +155,20 @@ impl Schedule {
             .sum()
     }
 
+    /// Modules at the end: the initial ones, plus those that enter, less
+    /// those that leave.
+    pub fn final_module_count(&self) -> usize {
+        let (mut enter, mut leave) = (0usize, 0usize);
+        for e in self.steps.iter().flat_map(|s| &s.events) {
+            match e {
+                Event::Enter { .. } => enter += 1,
+                Event::Leave { .. } => leave += 1,
+                _ => {}
+            }
+        }
+        (self.modules.len() + enter).saturating_sub(leave)
+    }
+
     /// Parses a schedule from JSON text; `origin` names it in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Schedule, InputError> {
         let schedule: Schedule = serde_json::from_str(text)

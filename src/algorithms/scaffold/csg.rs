@@ -13,7 +13,12 @@ use crate::error::InputError;
 use glam::DVec3;
 use std::collections::HashMap;
 
-const TOL: f64 = 1e-9;
+/// How far outside a solid a cell centre may lie and still be a cell of
+/// the shape, in units of d. Cell centres of round shapes fall within
+/// thousandths of d of the boundary (a dome of radius 10 has a branch cell
+/// at 10.0037): membership must not hinge on rounding. 0.05 d (0.18 mm
+/// for 3.6 mm catoms) is well under any dimension a shape is drawn to.
+pub const MEMBERSHIP_TOL: f64 = 0.05;
 
 /// A CSG solid.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,24 +33,33 @@ pub enum Node {
 }
 
 impl Node {
+    /// Whether `p` lies in the solid grown by [`MEMBERSHIP_TOL`] (the
+    /// subtracted parts of a difference shrunk by it).
     pub fn contains(&self, p: DVec3) -> bool {
+        self.contains_within(p, MEMBERSHIP_TOL)
+    }
+
+    /// Whether `p` lies in the solid offset outwards by `tol` (inwards
+    /// when `tol < 0`).
+    pub fn contains_within(&self, p: DVec3, tol: f64) -> bool {
         match self {
             Node::Cube { size, center } => {
                 let lo = if *center { -*size / 2.0 } else { DVec3::ZERO };
                 let hi = lo + *size;
-                p.cmpge(lo - TOL).all() && p.cmple(hi + TOL).all()
+                p.cmpge(lo - tol).all() && p.cmple(hi + tol).all()
             }
-            Node::Sphere { r } => p.length() <= r + TOL,
+            Node::Sphere { r } => p.length() <= r + tol,
             Node::Cylinder { h, r, center } => {
                 let z0 = if *center { -h / 2.0 } else { 0.0 };
-                p.z >= z0 - TOL && p.z <= z0 + h + TOL && (p.x * p.x + p.y * p.y).sqrt() <= r + TOL
+                p.z >= z0 - tol && p.z <= z0 + h + tol && (p.x * p.x + p.y * p.y).sqrt() <= r + tol
             }
-            Node::Translate { v, child } => child.contains(p - *v),
-            Node::Union(c) => c.iter().any(|n| n.contains(p)),
+            Node::Translate { v, child } => child.contains_within(p - *v, tol),
+            Node::Union(c) => c.iter().any(|n| n.contains_within(p, tol)),
             Node::Difference(c) => {
-                c.first().is_some_and(|f| f.contains(p)) && !c[1..].iter().any(|n| n.contains(p))
+                c.first().is_some_and(|f| f.contains_within(p, tol))
+                    && !c[1..].iter().any(|n| n.contains_within(p, -tol))
             }
-            Node::Intersection(c) => !c.is_empty() && c.iter().all(|n| n.contains(p)),
+            Node::Intersection(c) => !c.is_empty() && c.iter().all(|n| n.contains_within(p, tol)),
         }
     }
 
@@ -486,6 +500,36 @@ mod tests {
         assert!(h.root.contains(DVec3::new(1.0, 1.0, 1.0)));
         assert!(!h.root.contains(DVec3::new(1.0, 1.0, -1.0)));
         assert!(h.root.contains(DVec3::new(-1.0, -1.0, -1.0)));
+    }
+
+    /// The domed cube's knife edge: a branch cell 0.0037 d outside a dome
+    /// of radius 10 is a cell of the shape; 0.1 d outside is not. A
+    /// subtracted solid is shrunk by the tolerance, so a cell 0.01 d inside
+    /// a hole's wall is kept, and one 0.1 d inside it is removed.
+    #[test]
+    fn membership_has_a_stated_tolerance_of_a_twentieth_of_d() {
+        assert_eq!(MEMBERSHIP_TOL, 0.05);
+        let dome = Node::Sphere { r: 10.0 };
+        assert!(dome.contains(DVec3::new(10.0037, 0.0, 0.0)));
+        assert!(!dome.contains(DVec3::new(10.1, 0.0, 0.0)));
+        let holed = Node::Difference(vec![
+            Node::Cube {
+                size: DVec3::splat(10.0),
+                center: false,
+            },
+            Node::Translate {
+                v: DVec3::new(5.0, 5.0, 0.0),
+                child: Box::new(Node::Cylinder {
+                    h: 10.0,
+                    r: 2.0,
+                    center: false,
+                }),
+            },
+        ]);
+        assert!(holed.contains(DVec3::new(5.0 + 1.99, 5.0, 1.0)));
+        assert!(!holed.contains(DVec3::new(5.0 + 1.9, 5.0, 1.0)));
+        assert!(holed.contains(DVec3::new(10.03, 1.0, 1.0)));
+        assert!(!holed.contains(DVec3::new(f64::NAN, 1.0, 1.0)));
     }
 
     #[test]

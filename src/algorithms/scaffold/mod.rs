@@ -5,11 +5,13 @@
 //! * [`scaffold`] — tiles, branches, supports, sandbox, entry points;
 //! * [`polytree`] — the construction order;
 //! * [`planner`] — motion of every module from the sandbox to its cell;
+//! * [`paper`] — the paper's own motion constraint and light protocol;
 //! * [`plot`] — modules-placed-per-step curves (seed 000 Fig. 13–16).
 //!
 //! See `docs/scaffold.md`.
 
 pub mod csg;
+pub mod paper;
 pub mod planner;
 pub mod plot;
 pub mod polytree;
@@ -24,6 +26,7 @@ use crate::lattice::config::{Ground, ModuleId};
 use crate::lattice::{Cell, LatticeKind};
 use crate::scenario::Scenario;
 use crate::schedule::{Length, ModuleSpec, Schedule, Step};
+use paper::Protocol;
 use scaffold::Scaffold;
 use serde::Deserialize;
 use shape::{CubeShape, Pyramid, Shape, Skew};
@@ -40,11 +43,15 @@ pub enum ShapeSpec {
     Csg { path: PathBuf },
 }
 
-/// Rules the planner uses: the FCC motion rules the geometry layer derives
-/// from the exact catom body (SPEC §4.4).
-pub fn motion_rules() -> Result<&'static dyn MotionRules, InputError> {
-    crate::geometry::motion_rules(LatticeKind::Fcc)
-        .ok_or_else(|| InputError::new("this build derives no FCC motion rules to plan with"))
+/// Rules the planner uses: for the safe protocol, the FCC motion rules the
+/// geometry layer derives from the exact catom body (SPEC §4.4); for the
+/// paper's, its §3 bridging constraint alone.
+pub fn motion_rules(protocol: Protocol) -> Result<&'static dyn MotionRules, InputError> {
+    match protocol {
+        Protocol::Safe => crate::geometry::motion_rules(LatticeKind::Fcc)
+            .ok_or_else(|| InputError::new("this build derives no FCC motion rules to plan with")),
+        Protocol::Paper => Ok(&paper::BridgingRules),
+    }
 }
 
 /// Largest side of a scaffold's shape, in cells (3.7 m of 3.6 mm catoms):
@@ -130,8 +137,17 @@ pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError>
 /// length `b` from the sandbox (No-Surplus variant: exactly one module per
 /// scaffold cell).
 pub fn scaffold_schedule(shape: &ShapeSpec, b: u32) -> Result<Schedule, InputError> {
+    scaffold_schedule_with(shape, b, Protocol::Safe)
+}
+
+/// [`scaffold_schedule`] with the coordination `protocol` (see [`paper`]).
+pub fn scaffold_schedule_with(
+    shape: &ShapeSpec,
+    b: u32,
+    protocol: Protocol,
+) -> Result<Schedule, InputError> {
     let s = build_scaffold(shape, b)?;
-    let mut sched = schedule_for(&s, motion_rules()?)?;
+    let mut sched = schedule_for(&s, motion_rules(protocol)?, protocol)?;
     sched
         .meta
         .insert("shape".into(), format!("{shape:?}").into());
@@ -139,7 +155,11 @@ pub fn scaffold_schedule(shape: &ShapeSpec, b: u32) -> Result<Schedule, InputErr
 }
 
 /// Plans every module of a scaffold and writes the schedule.
-pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, InputError> {
+pub fn schedule_for(
+    s: &Scaffold,
+    rules: &dyn MotionRules,
+    protocol: Protocol,
+) -> Result<Schedule, InputError> {
     let tree = polytree::Polytree::build(s);
     let n = s.components.len();
     let mut succ = vec![Vec::new(); n];
@@ -161,7 +181,7 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
         .filter(|&i| missing[i] == 0)
         .map(|i| std::cmp::Reverse((0, rank[i], i)))
         .collect();
-    let mut planner = planner::Planner::new(s, rules);
+    let mut planner = planner::Planner::new(s, rules, protocol);
     let mut next_id = s.sandbox.len() as ModuleId;
     let mut sources = std::collections::BTreeSet::new();
     let all_sources: Vec<(Skew, Cell)> = s
@@ -231,7 +251,6 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
             "construction order is cyclic: {planned} of {n} components planned"
         )));
     }
-    report_timing(planner.timing);
     let mut sched = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
     sched.ground = Some(Ground {
         layer: s.sandbox_layer,
@@ -257,6 +276,7 @@ pub fn schedule_for(s: &Scaffold, rules: &dyn MotionRules) -> Result<Schedule, I
         .collect();
     sched.meta.insert("algorithm".into(), "scaffold".into());
     sched.meta.insert("b".into(), s.b.into());
+    sched.meta.insert("protocol".into(), protocol.name().into());
     sched.meta.insert("tiles".into(), s.tiles.len().into());
     sched.meta.insert("scaffold_modules".into(), n.into());
     sched
@@ -280,6 +300,9 @@ struct Params {
     /// CSG file, relative to the scenario (with `shape = "csg"`).
     #[serde(default)]
     csg: Option<String>,
+    /// "safe" (default) or "paper" (see [`paper::Protocol`]).
+    #[serde(default)]
+    protocol: Option<String>,
 }
 
 fn default_b() -> u32 {
@@ -324,12 +347,14 @@ impl Generator for ScaffoldAssembly {
                 )));
             }
         };
-        scaffold_schedule(&spec, p.b).map_err(|e| e.in_file(&scenario.path))
-    }
-}
-
-fn report_timing(t: (f64, f64)) {
-    if std::env::var("SCAFFOLD_TIMING").is_ok() {
-        eprintln!("route search {:.2} s, timing {:.2} s", t.0, t.1);
+        let protocol = match p.protocol.as_deref() {
+            None => Protocol::Safe,
+            Some(name) => Protocol::parse(name).ok_or_else(|| {
+                scenario.error(format!(
+                    "unknown protocol '{name}' in parameter protocol (known: safe, paper)"
+                ))
+            })?,
+        };
+        scaffold_schedule_with(&spec, p.b, protocol).map_err(|e| e.in_file(&scenario.path))
     }
 }

@@ -6,21 +6,26 @@
 //! precedences), with prioritised space–time planning:
 //!
 //! 1. a static route is searched (A*) over the structure the earlier
-//!    modules leave behind, with every rotation accepted by the lattice's
-//!    geometry-derived [`MotionRules`] (blocking cells empty);
+//!    modules leave behind, with every rotation accepted by the
+//!    [`MotionRules`] of the protocol: the rules derived from the exact
+//!    catom body (safe), or the paper's bridging constraint (paper);
 //! 2. the module then follows that route in time against the trajectories
-//!    of the modules already planned: it waits while a pivot is not yet in
-//!    place, while its component's predecessors are not yet in place, or
-//!    while moving would break the gap that §3.3.4's light protocol keeps
-//!    between free agents (no two free agents in neighbouring cells, before
-//!    or after any step, and nobody inside another mover's blocking cells);
+//!    of the modules already planned, which move concurrently with it: it
+//!    waits while a pivot or a predecessor component is not yet in place,
+//!    while the next cell is held or swept by another agent, while the
+//!    rotation is disallowed with the other agents (before and after the
+//!    step) counted as obstacles or would sweep a cell another rotation of
+//!    the step sweeps, and — in the paper's protocol — while its light
+//!    pivot is red or orange (§3.3.4);
 //! 3. if waiting is impossible (another module comes by), its departure
 //!    is delayed by one step and it tries again. Departing after every
 //!    earlier module has arrived always succeeds, so planning terminates.
 //!
-//! This replaces the paper's hand-written local rules and green-light
-//! handshake by a search that imposes the same invariants.
+//! The safe protocol asks exactly what the swept cells require: no gap
+//! between free agents beyond that (an earlier version kept free agents
+//! out of neighbouring cells, 13–25 % slower, see docs/scaffold.md).
 
+use super::paper::Protocol;
 use super::scaffold::Scaffold;
 use super::shape::Skew;
 use crate::error::InputError;
@@ -66,6 +71,7 @@ pub struct Hop {
 /// reservations of every module planned so far.
 pub struct Planner<'a> {
     rules: &'a dyn MotionRules,
+    protocol: Protocol,
     table: [[&'static [Route]; 12]; 12],
     /// Cells holding a static module once everything planned is in place.
     occupied: FxHashSet<Cell>,
@@ -98,7 +104,7 @@ pub struct Planner<'a> {
 
 impl<'a> Planner<'a> {
     /// A planner over `scaffold`'s sandbox (module ids `0..sandbox.len()`).
-    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules) -> Planner<'a> {
+    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules, protocol: Protocol) -> Planner<'a> {
         let mut occupied = FxHashSet::default();
         let mut module_at = FxHashMap::default();
         for (i, s) in scaffold.sandbox.iter().enumerate() {
@@ -113,6 +119,7 @@ impl<'a> Planner<'a> {
         }
         Planner {
             rules,
+            protocol,
             table: rotation_table(),
             occupied,
             module_at,
@@ -213,7 +220,15 @@ impl<'a> Planner<'a> {
                     if best.get(&to).is_some_and(|&(bg, _)| bg <= ng) {
                         continue;
                     }
-                    let Some(&route) = routes.iter().find(|&&route| {
+                    // The paper's model allows both routes of a 60° link;
+                    // its catoms take the hexagonal one (the shorter
+                    // actuator path, §3 Fig. 1b). The safe protocol takes
+                    // the first the body allows.
+                    let mut order = routes.to_vec();
+                    if self.protocol == Protocol::Paper {
+                        order.reverse();
+                    }
+                    let Some(&route) = order.iter().find(|&&route| {
                         self.rules.allows(
                             &Motion::Rotate {
                                 from: c,
@@ -234,19 +249,14 @@ impl<'a> Planner<'a> {
         None
     }
 
+    /// Whether cell `c` is free at the end of step `t`: no free agent
+    /// holds it and no rotation of that step sweeps it. That is all the
+    /// geometry asks of the cells themselves; the rest is checked per
+    /// move (the rules with the agents as obstacles, disjoint sweeps) and,
+    /// in the paper's protocol, by the light pivots.
     fn clear(&self, c: Cell, t: usize) -> bool {
-        if t >= self.positions.len() {
-            return true;
-        }
-        if self.swept[t].contains(&c) {
-            return false;
-        }
-        let p = &self.positions[t];
-        if p.is_empty() {
-            return true;
-        }
-        let l = FccLattice;
-        !p.contains_key(&c) && (0..12).all(|k| !p.contains_key(&l.neighbour(c, k)))
+        t >= self.positions.len()
+            || (!self.swept[t].contains(&c) && !self.positions[t].contains_key(&c))
     }
 
     /// Whether a module arriving at `c` at the end of `step` leaves every
@@ -280,6 +290,38 @@ impl<'a> Planner<'a> {
                 .blocking_cells(m)
                 .into_iter()
                 .all(|b| !self.swept[step].contains(&b))
+    }
+
+    /// The *light pivot* of a rotation to `to` (§3.3.4): among the static
+    /// modules `to` will touch, the one further along the path — nearest
+    /// to `aim` (the next cell of the route, or `to` itself on the last
+    /// hop), the rotation's pivot only when it is the sole neighbour.
+    fn light_pivot(&self, to: Cell, pivot: Cell, aim: Cell, step: usize) -> Cell {
+        let l = FccLattice;
+        let a = l.centre(aim);
+        (0..12)
+            .map(|k| l.neighbour(to, k))
+            .filter(|&q| q != pivot && self.module_at.get(&q).is_some_and(|&(_, at)| at < step))
+            .min_by(|&p, &q| {
+                let (dp, dq) = ((l.centre(p) - a).length(), (l.centre(q) - a).length());
+                dp.total_cmp(&dq)
+                    .then((p.x, p.y, p.z).cmp(&(q.x, q.y, q.z)))
+            })
+            .unwrap_or(pivot)
+    }
+
+    /// Whether light pivot `lp` is green at the end of step `t`: no free
+    /// agent on any of its connectors. An agent standing on its final
+    /// cell has sent FINAL-TARGET-REACHED and no longer counts.
+    fn light_is_green(&self, lp: Cell, t: usize) -> bool {
+        if t >= self.positions.len() {
+            return true;
+        }
+        let l = FccLattice;
+        let p = &self.positions[t];
+        (0..12)
+            .map(|k| l.neighbour(lp, k))
+            .all(|q| !p.contains_key(&q) || self.module_at.get(&q).is_some_and(|&(_, at)| at <= t))
     }
 
     fn free_of_agents(&self, c: Cell, t: usize) -> bool {
@@ -330,6 +372,14 @@ impl<'a> Planner<'a> {
                             || !self.free_of_agents(q, step)
                     };
                     ok = self.rules.allows(&m, &occ) && self.sweep_is_free(&m, step);
+                    if ok && self.protocol == Protocol::Paper {
+                        // PROBE-LIGHT-STATE / GREEN-LIGHT-ON: the move
+                        // waits while its light pivot is red or orange
+                        // (another free agent on it), before or after.
+                        let aim = hops.get(i + 1).map_or(hop.to, |h| h.to);
+                        let lp = self.light_pivot(hop.to, hop.pivot, aim, step);
+                        ok = self.light_is_green(lp, t) && self.light_is_green(lp, step);
+                    }
                 }
                 if ok && last {
                     // Once in place, the module must not stand in the way

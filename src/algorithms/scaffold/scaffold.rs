@@ -165,199 +165,11 @@ impl Scaffold {
             )));
         }
         let bi = b as i32;
-        let fl = |v: i32| v.div_euclid(bi);
-        let ce = |v: i32| (v + bi - 1).div_euclid(bi);
-        let mut tiles: BTreeMap<Skew, Tile> = BTreeMap::new();
-        for k in fl(lo.z).max(0)..=fl(hi.z) {
-            // Skewed x of a cell shifts by −z/2 per layer: widen the range.
-            let z = k * bi;
-            for i in fl(lo.x - z)..=ce(hi.x + 1) {
-                for j in fl(lo.y - z)..=ce(hi.y + 1) {
-                    let r = Skew::new(i * bi, j * bi, z);
-                    if shape.contains(r) {
-                        tiles.insert(
-                            r,
-                            Tile {
-                                layer: k,
-                                ..Default::default()
-                            },
-                        );
-                    }
-                }
-            }
-        }
-        if !tiles.values().any(|t| t.layer == 0) {
-            return Err(InputError::new(format!(
-                "{} has no tile root on the ground layer: seed 000 builds from the sandbox under the scene, \
-                 so a shape must rest on the ground with at least one tile root at a multiple of b = {b}",
-                shape.describe()
-            )));
-        }
-        // The scene is the half-space z ≥ 0 above the sandbox: parts of a
-        // shape below the ground (a sphere's lower half) are not built.
-        let is_tile = |r: Skew| tiles.contains_key(&r);
-        let roots: Vec<Skew> = tiles.keys().copied().collect();
-        let mut info: BTreeMap<Skew, Tile> = BTreeMap::new();
-        for &r in &roots {
-            let mut t = tiles[&r].clone();
-            for u in Dir::UPWARD {
-                let from = r.offset(u.step().scale(-bi));
-                if t.layer == 0 || is_tile(from) {
-                    t.ingoing_up.push(u);
-                }
-            }
-            if t.ingoing_up.is_empty() {
-                return Err(InputError::new(format!(
-                    "tile root {:?} (tile layer {}) of {} has no tile under it to feed it: the shape \
-                     overhangs. Seed 000 §5 builds semi-convex shapes only (no layer wider than the \
-                     layer below it, as seen from the sandbox); §6's downward growth is not implemented",
-                    (r.x, r.y, r.z),
-                    t.layer,
-                    shape.describe()
-                )));
-            }
-            for h in [Dir::X, Dir::Y] {
-                if is_tile(r.offset(h.step().scale(-bi))) {
-                    t.ingoing_h.push(h);
-                }
-            }
-            for d in [
-                Dir::X,
-                Dir::Y,
-                Dir::OppX,
-                Dir::OppY,
-                Dir::Z,
-                Dir::RZ,
-                Dir::RevZ,
-                Dir::LZ,
-            ] {
-                let far = r.offset(d.step().scale(bi));
-                let opp = matches!(d, Dir::OppX | Dir::OppY);
-                if opp && is_tile(far) {
-                    continue; // that tile grows its own X / Y branch
-                }
-                let mut len = 0;
-                while len < bi - 1 && shape.contains(r.offset(d.step().scale(len + 1))) {
-                    len += 1;
-                }
-                if is_tile(far) && len < bi - 1 {
-                    return Err(InputError::new(format!(
-                        "the {} branch between tile roots {:?} and {:?} of {} leaves the shape: a concavity \
-                         between two tiles; seed 000 §5 builds semi-convex shapes only",
-                        d.name(),
-                        (r.x, r.y, r.z),
-                        (far.x, far.y, far.z),
-                        shape.describe()
-                    )));
-                }
-                if len == 0 {
-                    continue;
-                }
-                t.branches.push((d, len as u32));
-            }
-            info.insert(r, t);
-        }
-        // Counted before the cells are made: a scaffold too large to plan
-        // is refused in a moment, not after minutes of building.
-        let modules: usize = info
-            .values()
-            .map(|t| {
-                1 + t.ingoing_up.len() + t.branches.iter().map(|&(_, l)| l as usize).sum::<usize>()
-            })
-            .sum();
-        if modules > super::MAX_MODULES {
-            return Err(InputError::new(format!(
-                "the scaffold of {} with b = {b} would have {modules} modules; this build plans at most {}",
-                shape.describe(),
-                super::MAX_MODULES
-            )));
-        }
-
-        let mut components = Vec::new();
-        let mut index: FxHashMap<Skew, usize> = FxHashMap::default();
-        let mut push = |c: Component, components: &mut Vec<Component>| -> Result<(), InputError> {
-            if let Some(&other) = index.get(&c.cell) {
-                let o: &Component = &components[other];
-                return Err(InputError::new(format!(
-                    "cell {:?} would be both {:?} of tile {:?} and {:?} of tile {:?}: the shape is too thin \
-                     between tiles for this scaffold",
-                    (c.cell.x, c.cell.y, c.cell.z),
-                    c.part,
-                    (c.tile.x, c.tile.y, c.tile.z),
-                    o.part,
-                    (o.tile.x, o.tile.y, o.tile.z)
-                )));
-            }
-            index.insert(c.cell, components.len());
-            components.push(c);
-            Ok(())
-        };
-        for (&r, t) in &info {
-            push(
-                Component {
-                    tile: r,
-                    part: Part::Root,
-                    cell: r,
-                },
-                &mut components,
-            )?;
-            for &u in &t.ingoing_up {
-                let s = u.mirror();
-                push(
-                    Component {
-                        tile: r,
-                        part: Part::Support(s),
-                        cell: r.offset(s.support_offset()),
-                    },
-                    &mut components,
-                )?;
-            }
-            for &(d, len) in &t.branches {
-                for m in 1..=len {
-                    push(
-                        Component {
-                            tile: r,
-                            part: Part::Branch(d, m),
-                            cell: r.offset(d.step().scale(m as i32)),
-                        },
-                        &mut components,
-                    )?;
-                }
-            }
-        }
-
-        // The sandbox: the tiles of the layer under the ground tiles, with
-        // their upward branches into the ground tiles (§3.2.6, Fig. 3).
-        let mut sandbox: Vec<Skew> = Vec::new();
-        let mut seen: rustc_hash::FxHashSet<Skew> = Default::default();
-        let mut sand_roots: rustc_hash::FxHashSet<Skew> = Default::default();
-        for (&g, _) in info.iter().filter(|(_, t)| t.layer == 0) {
-            for u in Dir::UPWARD {
-                let q = g.offset(u.step().scale(-bi));
-                sand_roots.insert(q);
-                for m in 0..bi {
-                    let c = q.offset(u.step().scale(m));
-                    if seen.insert(c) {
-                        sandbox.push(c);
-                    }
-                }
-            }
-        }
-        let mut sr: Vec<Skew> = sand_roots.iter().copied().collect();
-        sr.sort();
-        for &q in &sr {
-            for h in [Dir::X, Dir::Y] {
-                if sand_roots.contains(&q.offset(h.step().scale(bi))) {
-                    for m in 1..bi {
-                        let c = q.offset(h.step().scale(m));
-                        if seen.insert(c) {
-                            sandbox.push(c);
-                        }
-                    }
-                }
-            }
-        }
-        sandbox.sort();
+        let tiles = tile_roots(shape, bi, bounds)?;
+        let info = connect_tiles(shape, bi, &tiles)?;
+        check_module_count(shape, b, &info)?;
+        let (components, index) = place_components(&info)?;
+        let sandbox = sandbox_under(&info, bi);
         Ok(Scaffold {
             b: bi,
             tiles: info,
@@ -423,6 +235,244 @@ impl Scaffold {
     pub fn module_count(&self) -> usize {
         self.components.len()
     }
+}
+
+/// The tile roots inside the shape, at skewed `(b·i, b·j, b·k)` (§3.2.2),
+/// refused when none stands on the ground.
+fn tile_roots(
+    shape: &dyn Shape,
+    bi: i32,
+    (lo, hi): (Skew, Skew),
+) -> Result<BTreeMap<Skew, Tile>, InputError> {
+    let b = bi;
+    let fl = |v: i32| v.div_euclid(bi);
+    let ce = |v: i32| (v + bi - 1).div_euclid(bi);
+    let mut tiles: BTreeMap<Skew, Tile> = BTreeMap::new();
+    for k in fl(lo.z).max(0)..=fl(hi.z) {
+        // Skewed x of a cell shifts by −z/2 per layer: widen the range.
+        let z = k * bi;
+        for i in fl(lo.x - z)..=ce(hi.x + 1) {
+            for j in fl(lo.y - z)..=ce(hi.y + 1) {
+                let r = Skew::new(i * bi, j * bi, z);
+                if shape.contains(r) {
+                    tiles.insert(
+                        r,
+                        Tile {
+                            layer: k,
+                            ..Default::default()
+                        },
+                    );
+                }
+            }
+        }
+    }
+    if !tiles.values().any(|t| t.layer == 0) {
+        return Err(InputError::new(format!(
+            "{} has no tile root on the ground layer: seed 000 builds from the sandbox under the scene, \
+             so a shape must rest on the ground with at least one tile root at a multiple of b = {b}",
+            shape.describe()
+        )));
+    }
+    Ok(tiles)
+}
+
+/// Each tile's ingoing and outgoing branches (§3.2.2, §5.2.2), refused
+/// where a tile is fed by no complete upward branch (an overhang).
+fn connect_tiles(
+    shape: &dyn Shape,
+    bi: i32,
+    tiles: &BTreeMap<Skew, Tile>,
+) -> Result<BTreeMap<Skew, Tile>, InputError> {
+    // The scene is the half-space z ≥ 0 above the sandbox: parts of a
+    // shape below the ground (a sphere's lower half) are not built.
+    let is_tile = |r: Skew| tiles.contains_key(&r);
+    // A branch from tile `r` along `d` is complete when all its b − 1
+    // cells are in the shape. Where a concavity cuts it, the authors'
+    // implementation grows it up to the first cell outside and no
+    // longer counts it as an ingoing branch of the tile it would reach
+    // (VisibleSim scaffolding_csg); so does this one.
+    let complete = |r: Skew, d: Dir| (1..bi).all(|m| shape.contains(r.offset(d.step().scale(m))));
+    let roots: Vec<Skew> = tiles.keys().copied().collect();
+    let mut info: BTreeMap<Skew, Tile> = BTreeMap::new();
+    for &r in &roots {
+        let mut t = tiles[&r].clone();
+        for u in Dir::UPWARD {
+            let from = r.offset(u.step().scale(-bi));
+            if t.layer == 0 || (is_tile(from) && complete(from, u)) {
+                t.ingoing_up.push(u);
+            }
+        }
+        if t.ingoing_up.is_empty() {
+            return Err(InputError::new(format!(
+                "tile root {:?} (tile layer {}) of {} has no tile under it to feed it through a \
+                 complete upward branch: the shape overhangs. Seed 000 §5 builds semi-convex shapes \
+                 only (no layer wider than the layer below it, as seen from the sandbox); §6's \
+                 downward growth is not implemented",
+                (r.x, r.y, r.z),
+                t.layer,
+                shape.describe()
+            )));
+        }
+        for h in [Dir::X, Dir::Y] {
+            let from = r.offset(h.step().scale(-bi));
+            if is_tile(from) && complete(from, h) {
+                t.ingoing_h.push(h);
+            }
+        }
+        for d in [
+            Dir::X,
+            Dir::Y,
+            Dir::OppX,
+            Dir::OppY,
+            Dir::Z,
+            Dir::RZ,
+            Dir::RevZ,
+            Dir::LZ,
+        ] {
+            let far = r.offset(d.step().scale(bi));
+            let opp = matches!(d, Dir::OppX | Dir::OppY);
+            if opp && is_tile(far) {
+                continue; // that tile grows its own X / Y branch
+            }
+            let mut len = 0;
+            while len < bi - 1 && shape.contains(r.offset(d.step().scale(len + 1))) {
+                len += 1;
+            }
+            if len == 0 {
+                continue;
+            }
+            t.branches.push((d, len as u32));
+        }
+        info.insert(r, t);
+    }
+    Ok(info)
+}
+
+/// Counted before the cells are made: a scaffold too large to plan is
+/// refused in a moment, not after minutes of building.
+fn check_module_count(
+    shape: &dyn Shape,
+    b: u32,
+    info: &BTreeMap<Skew, Tile>,
+) -> Result<(), InputError> {
+    // Counted before the cells are made: a scaffold too large to plan
+    // is refused in a moment, not after minutes of building.
+    let modules: usize = info
+        .values()
+        .map(|t| {
+            1 + t.ingoing_up.len() + t.branches.iter().map(|&(_, l)| l as usize).sum::<usize>()
+        })
+        .sum();
+    if modules > super::MAX_MODULES {
+        return Err(InputError::new(format!(
+            "the scaffold of {} with b = {b} would have {modules} modules; this build plans at most {}",
+            shape.describe(),
+            super::MAX_MODULES
+        )));
+    }
+
+    Ok(())
+}
+
+/// The scaffold's cells: roots, supports (one per ingoing upward branch)
+/// and branch modules, refused where two would claim one cell.
+#[allow(clippy::type_complexity)]
+fn place_components(
+    info: &BTreeMap<Skew, Tile>,
+) -> Result<(Vec<Component>, FxHashMap<Skew, usize>), InputError> {
+    let mut components = Vec::new();
+    let mut index: FxHashMap<Skew, usize> = FxHashMap::default();
+    let mut push = |c: Component, components: &mut Vec<Component>| -> Result<(), InputError> {
+        if let Some(&other) = index.get(&c.cell) {
+            let o: &Component = &components[other];
+            return Err(InputError::new(format!(
+                "cell {:?} would be both {:?} of tile {:?} and {:?} of tile {:?}: the shape is too thin \
+                 between tiles for this scaffold",
+                (c.cell.x, c.cell.y, c.cell.z),
+                c.part,
+                (c.tile.x, c.tile.y, c.tile.z),
+                o.part,
+                (o.tile.x, o.tile.y, o.tile.z)
+            )));
+        }
+        index.insert(c.cell, components.len());
+        components.push(c);
+        Ok(())
+    };
+    for (&r, t) in info {
+        push(
+            Component {
+                tile: r,
+                part: Part::Root,
+                cell: r,
+            },
+            &mut components,
+        )?;
+        for &u in &t.ingoing_up {
+            let s = u.mirror();
+            push(
+                Component {
+                    tile: r,
+                    part: Part::Support(s),
+                    cell: r.offset(s.support_offset()),
+                },
+                &mut components,
+            )?;
+        }
+        for &(d, len) in &t.branches {
+            for m in 1..=len {
+                push(
+                    Component {
+                        tile: r,
+                        part: Part::Branch(d, m),
+                        cell: r.offset(d.step().scale(m as i32)),
+                    },
+                    &mut components,
+                )?;
+            }
+        }
+    }
+
+    Ok((components, index))
+}
+
+/// The sandbox: the tiles of the layer under the ground tiles, with their
+/// upward branches into the ground tiles and the horizontal branches
+/// between them (§3.2.6, Fig. 3).
+fn sandbox_under(info: &BTreeMap<Skew, Tile>, bi: i32) -> Vec<Skew> {
+    // The sandbox: the tiles of the layer under the ground tiles, with
+    // their upward branches into the ground tiles (§3.2.6, Fig. 3).
+    let mut sandbox: Vec<Skew> = Vec::new();
+    let mut seen: rustc_hash::FxHashSet<Skew> = Default::default();
+    let mut sand_roots: rustc_hash::FxHashSet<Skew> = Default::default();
+    for (&g, _) in info.iter().filter(|(_, t)| t.layer == 0) {
+        for u in Dir::UPWARD {
+            let q = g.offset(u.step().scale(-bi));
+            sand_roots.insert(q);
+            for m in 0..bi {
+                let c = q.offset(u.step().scale(m));
+                if seen.insert(c) {
+                    sandbox.push(c);
+                }
+            }
+        }
+    }
+    let mut sr: Vec<Skew> = sand_roots.iter().copied().collect();
+    sr.sort();
+    for &q in &sr {
+        for h in [Dir::X, Dir::Y] {
+            if sand_roots.contains(&q.offset(h.step().scale(bi))) {
+                for m in 1..bi {
+                    let c = q.offset(h.step().scale(m));
+                    if seen.insert(c) {
+                        sandbox.push(c);
+                    }
+                }
+            }
+        }
+    }
+    sandbox.sort();
+    sandbox
 }
 
 #[cfg(test)]
