@@ -185,6 +185,7 @@ mod tests {
             schedule: "s".into(),
             lattice: crate::lattice::LatticeKind::Fcc,
             modules: 5,
+            final_modules: 5,
             steps: utilisations.len(),
             moves: 0,
             checks: vec![],

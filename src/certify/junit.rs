@@ -158,6 +158,7 @@ mod tests {
             schedule: "s.json".into(),
             lattice: crate::lattice::LatticeKind::Fcc,
             modules: 10,
+            final_modules: 10,
             steps: 3,
             moves: 3,
             checks: vec!["lattice".into(), "collision".into()],

@@ -63,6 +63,17 @@ impl MotionRules for BridgingRules {
         Vec::new()
     }
 
+    /// Nor any touched cells: the paper's model has no body to touch with.
+    fn touched_cells(&self, _motion: &Motion) -> Vec<Cell> {
+        Vec::new()
+    }
+
+    /// Concurrent moves are coordinated by the light handshake (the
+    /// planner's gate), not by geometry: the rules alone never part them.
+    fn concurrent_clear(&self, _a: &Motion, _b: &Motion) -> bool {
+        true
+    }
+
     fn allows(&self, motion: &Motion, occupied: &dyn Fn(Cell) -> bool) -> bool {
         let (from, to) = (motion.from(), motion.to());
         !bridged(from, [from, to], occupied) && !bridged(to, [from, to], occupied)
