@@ -166,3 +166,119 @@ fn a_free_floating_structure_that_stays_one_component_is_connected_on_every_step
         .collect();
     assert!(!loose.is_empty(), "{:?}", r.violations);
 }
+
+/// The shipped model with one line replaced, written beside the test's
+/// other files.
+fn edited_model(tag: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"),
+    )
+    .unwrap();
+    assert!(text.contains(from), "{from}");
+    let p = scratch(&format!("model-{tag}.toml"));
+    std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
+    p
+}
+
+/// The 7-branch (its root overloaded under the shipped model at 10 kPa)
+/// as a schedule file with the given spacing in mm.
+fn branch_schedule(tag: &str, spacing_mm: f64) -> PathBuf {
+    let p = scratch(&format!("branch-{tag}.json"));
+    let o = bin()
+        .args(["generate", "scenarios/branch.toml", "-o"])
+        .arg(&p)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    v["spacing"] = serde_json::json!({ "value": spacing_mm, "unit": "mm" });
+    std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+    p
+}
+
+#[test]
+fn a_model_whose_rescaled_mass_would_vanish_is_refused_naming_the_field() {
+    // A spacing of 1e200 mm: rescaled to the schedule's 3.6 mm the mass
+    // would underflow to 0 and an overloaded branch read as unloaded.
+    let model = edited_model("huge-spacing", "spacing_mm = 3.6", "spacing_mm = 1e200");
+    let o = bin()
+        .arg("certify")
+        .arg(branch_schedule("huge-model-spacing", 3.6))
+        .arg("--model")
+        .arg(&model)
+        .arg("--no-progress")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("module.spacing_mm"), "{err}");
+    assert!(err.contains("model-huge-spacing.toml"), "{err}");
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("CERTIFIED"));
+}
+
+#[test]
+fn a_schedule_spacing_that_makes_the_model_underflow_is_refused() {
+    // A normal spacing (1e-300 mm) whose cube, the module mass, underflows.
+    let o = bin()
+        .arg("certify")
+        .arg(branch_schedule("tiny-spacing", 1e-300))
+        .arg("--model")
+        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"))
+        .arg("--no-progress")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("underflows or overflows"), "{err}");
+    assert!(err.contains("catom-3.6mm.toml"), "{err}");
+}
+
+#[test]
+fn model_fields_out_of_their_range_are_refused_naming_the_field() {
+    for (tag, from, to, field) in [
+        (
+            "pressure",
+            "pressure_kpa = 100.0",
+            "pressure_kpa = 1e300",
+            "connector.pressure_kpa",
+        ),
+        (
+            "density",
+            "density_g_cm3 = 1.2",
+            "density_g_cm3 = 1e-300",
+            "module.density_g_cm3",
+        ),
+        (
+            "friction",
+            "friction = 0.5 ",
+            "friction = inf ",
+            "connector.friction",
+        ),
+        (
+            "gravity",
+            "gravity = 9.80665",
+            "gravity = 1e-320",
+            "gravity",
+        ),
+        (
+            "actuator",
+            "[stiffness]",
+            "[actuator]\npressure_kpa = nan\n\n[stiffness]",
+            "actuator.pressure_kpa",
+        ),
+    ] {
+        let model = edited_model(tag, from, to);
+        let o = bin()
+            .arg("certify")
+            .arg(branch_schedule(&format!("field-{tag}"), 3.6))
+            .arg("--model")
+            .arg(&model)
+            .arg("--no-progress")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{tag}: {err}");
+        assert!(err.contains(field), "{tag}: {err}");
+    }
+}

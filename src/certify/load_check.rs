@@ -9,6 +9,7 @@
 
 use super::report::{Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome, World};
+use crate::error::InputError;
 use crate::lattice::config::ModuleId;
 use crate::mechanics::analysis::{Analysis, Critical, Verdict};
 use crate::mechanics::structure::{End, MoverSpec, SceneRef, Structure};
@@ -28,9 +29,21 @@ pub struct LoadCheck {
 }
 
 impl LoadCheck {
-    /// A check with `model` at the schedule's lattice spacing `spacing` (m).
-    pub fn new(model: &Model, spacing: f64, incremental: bool) -> LoadCheck {
-        LoadCheck::at_spacing(model.at_spacing(spacing), incremental)
+    /// A check with `model` at the schedule's lattice spacing `spacing` (m),
+    /// refused where the rescaled model loses the physics (a mass that
+    /// underflows, a capacity that overflows).
+    pub fn new(model: &Model, spacing: f64, incremental: bool) -> Result<LoadCheck, InputError> {
+        Ok(LoadCheck::at_spacing(
+            model.at_spacing_checked(spacing)?,
+            incremental,
+        ))
+    }
+
+    /// A check with a model that skipped validation: for the tests that
+    /// prove a non-finite number still never certifies.
+    #[cfg(test)]
+    pub(crate) fn unvalidated(model: Model) -> LoadCheck {
+        LoadCheck::at_spacing(model, true)
     }
 
     /// A check with `model` already at the schedule's spacing, and a fresh
@@ -214,7 +227,7 @@ pub fn replay(
     incremental: bool,
     mut visit: impl FnMut(usize, &Structure, &Analysis, &StepOutcome),
 ) -> Result<(), crate::error::InputError> {
-    let check = LoadCheck::new(model, schedule.spacing.metres(), incremental);
+    let check = LoadCheck::new(model, schedule.spacing.metres(), incremental)?;
     let mut world = World::initial(schedule)?;
     for k in 0..schedule.steps.len() {
         let (_, _, clashes) = super::advance(&mut world, schedule, k, |ctx| {
@@ -334,7 +347,7 @@ mod tests {
         let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 2 }, 9).unwrap();
         let model = Model::load(&models().join("catom-3.6mm.toml")).unwrap();
         let run = |range_steps| {
-            let load = LoadCheck::new(&model, s.spacing.metres(), true);
+            let load = LoadCheck::new(&model, s.spacing.metres(), true).unwrap();
             let o = Options {
                 range_steps: Some(range_steps),
                 ..Default::default()

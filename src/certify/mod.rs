@@ -181,11 +181,9 @@ pub fn checks_for(
     }
     if let Some(path) = model_path(schedule, opts) {
         let model = crate::mechanics::Model::load(&path)?;
-        checks.push(Box::new(LoadCheck::new(
-            &model,
-            schedule.spacing.metres(),
-            true,
-        )));
+        let check = LoadCheck::new(&model, schedule.spacing.metres(), true)
+            .map_err(|e| e.in_file(&path))?;
+        checks.push(Box::new(check));
     }
     Ok(checks)
 }
@@ -600,8 +598,14 @@ mod tests {
         use crate::mechanics::Model;
         let s = crate::algorithms::branch::branch_schedule(3, 3.6).unwrap();
         let edits: [(&str, fn(&mut Model)); 6] = [
-            ("mass NaN", |m| m.mass = f64::NAN),
-            ("mass ∞", |m| m.mass = f64::INFINITY),
+            ("mass NaN", |m| {
+                m.density = None;
+                m.mass = f64::NAN
+            }),
+            ("mass ∞", |m| {
+                m.density = None;
+                m.mass = f64::INFINITY
+            }),
             ("gravity NaN", |m| m.gravity = f64::NAN),
             ("gravity ∞", |m| m.gravity = f64::INFINITY),
             ("pressure NaN", |m| m.connector.pressure = f64::NAN),
@@ -610,7 +614,13 @@ mod tests {
         for (what, edit) in edits {
             let mut m = Model::default_catom();
             edit(&mut m);
-            let check = LoadCheck::new(&m, s.spacing.metres(), true);
+            // Refused at the boundary …
+            assert!(
+                LoadCheck::new(&m, s.spacing.metres(), true).is_err(),
+                "{what}: accepted"
+            );
+            // … and, were it to get past, never certified.
+            let check = LoadCheck::unvalidated(m.at_spacing(s.spacing.metres()));
             let r = certify_with(&s, &Options::default(), &[&LatticeCheck, &check]).unwrap();
             assert!(!r.certified, "{what}: certified");
             assert!(

@@ -112,6 +112,8 @@ pub struct ModelFile {
     pub ground: GroundSection,
     #[serde(default)]
     pub stiffness: StiffnessSection,
+    #[serde(default)]
+    pub actuator: ActuatorSection,
     #[serde(default = "default_gravity")]
     pub gravity: f64,
 }
@@ -169,6 +171,22 @@ impl Default for GroundSection {
     }
 }
 
+/// The pivot's actuator surface that holds a mover during a rotation
+/// (seed 000 §3.1.1: the hexagonal and octagonal actuators), not a latched
+/// connector. The hold is judged like a connector square of side `side_mm`
+/// at `pressure_kpa` with friction `friction`. No published figure exists;
+/// the defaults are the connector's (the octagonal actuator's flat face is a
+/// square of the connector's side `L`), so that a model without this
+/// section judges the hold as before. `docs/mechanics.md` gives the
+/// hexagonal actuator's smaller triangle as the conservative alternative.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSection {
+    pub pressure_kpa: Option<f64>,
+    pub side_mm: Option<f64>,
+    pub friction: Option<f64>,
+}
+
 /// Elastic interface of a connector (only ratios matter: see `Stiffness`).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -223,6 +241,9 @@ pub struct Model {
     pub density: Option<f64>,
     pub connector: Capacity,
     pub ground: Capacity,
+    /// The pivot actuator's hold on a mover during its rotation, where the
+    /// model gives one; `None` holds like a connector ([`Model::hold`]).
+    pub actuator: Option<Capacity>,
     pub poisson: f64,
 }
 
@@ -242,44 +263,139 @@ impl Model {
 
     pub fn from_file(f: &ModelFile) -> Result<Model, InputError> {
         let bad = |m: String| InputError::new(format!("model '{}': {m}", f.name));
-        let positive = |v: f64, what: &str| {
-            if v.is_finite() && v > 0.0 {
+        // Every field in a range with a reason: beyond it the model's
+        // physics (rigid modules, a contact pressure, dry friction) means
+        // nothing, or its arithmetic underflows or overflows.
+        let ranged = |v: f64, what: &str, lo: f64, lo_open: bool, hi: f64, why: &str| {
+            let above = if lo_open { v > lo } else { v >= lo };
+            if v.is_finite() && above && v <= hi {
                 Ok(v)
             } else {
-                Err(bad(format!("{what} must be positive, got {v}")))
+                let open = if lo_open { "(" } else { "[" };
+                Err(bad(format!(
+                    "{what} must be in {open}{lo}, {hi}], got {v} ({why})"
+                )))
             }
         };
-        let d = positive(f.module.spacing_mm, "module.spacing_mm")? * 1e-3;
+        let d = ranged(
+            f.module.spacing_mm,
+            "module.spacing_mm",
+            1e-6,
+            false,
+            1e6,
+            "a module between 1 nm and 1 km; outside, the rescaled masses and capacities lose the physics",
+        )? * 1e-3;
         let (mass, density) = match (f.module.mass_mg, f.module.density_g_cm3) {
-            (Some(m), _) => (positive(m, "module.mass_mg")? * 1e-6, None),
+            (Some(m), _) => (
+                ranged(
+                    m,
+                    "module.mass_mg",
+                    0.0,
+                    true,
+                    1e15,
+                    "at most a million tonnes",
+                )? * 1e-6,
+                None,
+            ),
             (None, Some(rho)) => {
-                let rho = positive(rho, "module.density_g_cm3")? * 1e3;
+                let rho = ranged(
+                    rho,
+                    "module.density_g_cm3",
+                    1e-6,
+                    false,
+                    100.0,
+                    "between a rarefied gas and well above the densest element, osmium (22.6)",
+                )? * 1e3;
                 (rho * f.module.body.volume_fraction() * d.powi(3), Some(rho))
             }
             (None, None) => return Err(bad("module needs density_g_cm3 or mass_mg".into())),
         };
         let side = match f.connector.side_mm {
-            Some(s) => positive(s, "connector.side_mm")? * 1e-3,
+            Some(s) => {
+                ranged(
+                    s,
+                    "connector.side_mm",
+                    0.0,
+                    true,
+                    f.module.spacing_mm,
+                    "a connector square no wider than the module spacing",
+                )? * 1e-3
+            }
             None => f.module.body.connector_fraction() * d,
         };
-        let non_negative = |v: f64, what: &str| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(v)
-            } else {
-                Err(bad(format!("{what} must be ≥ 0, got {v}")))
-            }
-        };
+        const PRESSURE_WHY: &str = "at most 10 GPa, beyond the strength of any material";
+        const FRICTION_WHY: &str = "a dry-friction coefficient";
         let connector = Capacity {
-            pressure: positive(f.connector.pressure_kpa, "connector.pressure_kpa")? * 1e3,
+            pressure: ranged(
+                f.connector.pressure_kpa,
+                "connector.pressure_kpa",
+                0.0,
+                true,
+                1e7,
+                PRESSURE_WHY,
+            )? * 1e3,
             side,
-            friction: positive(f.connector.friction, "connector.friction")?,
+            friction: ranged(
+                f.connector.friction,
+                "connector.friction",
+                0.0,
+                true,
+                10.0,
+                FRICTION_WHY,
+            )?,
             bending: f.connector.bending,
         };
         let ground = Capacity {
-            pressure: non_negative(f.ground.pressure_kpa, "ground.pressure_kpa")? * 1e3,
+            pressure: ranged(
+                f.ground.pressure_kpa,
+                "ground.pressure_kpa",
+                0.0,
+                false,
+                1e7,
+                PRESSURE_WHY,
+            )? * 1e3,
             side,
-            friction: positive(f.ground.friction, "ground.friction")?,
+            friction: ranged(
+                f.ground.friction,
+                "ground.friction",
+                0.0,
+                true,
+                10.0,
+                FRICTION_WHY,
+            )?,
             bending: f.connector.bending,
+        };
+        let actuator_side = match f.actuator.side_mm {
+            Some(a) => {
+                ranged(
+                    a,
+                    "actuator.side_mm",
+                    0.0,
+                    true,
+                    f.module.spacing_mm,
+                    "a holding patch no wider than the module spacing",
+                )? * 1e-3
+            }
+            None => side,
+        };
+        let a = &f.actuator;
+        let actuator = if a.pressure_kpa.is_none() && a.side_mm.is_none() && a.friction.is_none() {
+            None
+        } else {
+            Some(Capacity {
+                pressure: match a.pressure_kpa {
+                    Some(p) => {
+                        ranged(p, "actuator.pressure_kpa", 0.0, true, 1e7, PRESSURE_WHY)? * 1e3
+                    }
+                    None => connector.pressure,
+                },
+                side: actuator_side,
+                friction: match a.friction {
+                    Some(mu) => ranged(mu, "actuator.friction", 0.0, true, 10.0, FRICTION_WHY)?,
+                    None => connector.friction,
+                },
+                bending: f.connector.bending,
+            })
         };
         let nu = f.stiffness.poisson;
         if !(0.0..0.5).contains(&nu) {
@@ -287,17 +403,102 @@ impl Model {
                 "stiffness.poisson must be in [0, 0.5), got {nu}"
             )));
         }
-        Ok(Model {
+        let m = Model {
             name: f.name.clone(),
             body: f.module.body,
             spacing: d,
             mass,
-            gravity: positive(f.gravity, "gravity")?,
+            gravity: ranged(
+                f.gravity,
+                "gravity",
+                1e-6,
+                false,
+                1e4,
+                "between micro-gravity and far above any planet's surface gravity, in m/s²",
+            )?,
             density,
             connector,
             ground,
+            actuator,
             poisson: nu,
-        })
+        };
+        m.check_derived().map_err(|e| bad(e))?;
+        Ok(m)
+    }
+
+    /// Refuses a model whose derived quantities lost the physics: the
+    /// weight, the capacities and their ratios to the weight must be normal
+    /// positive floats (not 0 by underflow, not infinite by overflow), so
+    /// that no verdict can follow from a number that vanished.
+    pub fn check_derived(&self) -> Result<(), String> {
+        let w = self.weight();
+        let normal = |v: f64| v.is_normal() && v > 0.0;
+        let checks = [
+            (
+                "module mass (from module.spacing_mm and the density)",
+                self.mass,
+            ),
+            ("module weight m·g", w),
+            (
+                "connector capacity p·L² (connector.pressure_kpa, side)",
+                self.connector.tension(),
+            ),
+            (
+                "connector capacity over weight p·L²/(m·g)",
+                self.connector.tension() / w,
+            ),
+            (
+                "connector moment capacity over weight moment p·L³/(m·g·d)",
+                self.connector.tension() * self.connector.side / (w * self.spacing),
+            ),
+            (
+                "actuator hold p·L² over weight (actuator.*)",
+                self.hold().tension() / w,
+            ),
+            (
+                "weight over connector capacity",
+                w / self.connector.tension(),
+            ),
+        ];
+        for (what, v) in checks {
+            if !normal(v) {
+                return Err(format!(
+                    "{what} is {v:e} at spacing {} m: the arithmetic underflows or overflows",
+                    self.spacing
+                ));
+            }
+        }
+        for (what, mu) in [
+            ("connector.friction", self.connector.friction),
+            ("ground.friction", self.ground.friction),
+            ("actuator.friction", self.hold().friction),
+        ] {
+            if !normal(mu) {
+                return Err(format!(
+                    "{what} is {mu}: a friction coefficient must be positive and finite"
+                ));
+            }
+        }
+        if !(self.ground.pressure.is_finite() && self.ground.pressure >= 0.0) {
+            return Err(format!(
+                "ground.pressure_kpa gives {} Pa: not a pressure",
+                self.ground.pressure
+            ));
+        }
+        if self.ground.pressure > 0.0 && !normal(self.ground.tension() / w) {
+            return Err(format!(
+                "ground capacity over weight (ground.pressure_kpa) is {:e}: the arithmetic underflows or overflows",
+                self.ground.tension() / w
+            ));
+        }
+        Ok(())
+    }
+
+    /// What holds a mover on its pivot during a rotation: the actuator's
+    /// capacity, or the connector's where the model gives none (so that a
+    /// connector pressure swept by the b-study moves the hold with it).
+    pub fn hold(&self) -> Capacity {
+        self.actuator.unwrap_or(self.connector)
     }
 
     /// Module weight `m·g` (N), the force unit of the analysis.
@@ -311,12 +512,29 @@ impl Model {
         let k = d / self.spacing;
         let mut m = self.clone();
         m.spacing = d;
-        if m.density.is_some() {
-            m.mass *= k.powi(3);
+        if let Some(rho) = m.density {
+            m.mass = rho * m.body.volume_fraction() * d.powi(3);
         }
         m.connector.side *= k;
         m.ground.side *= k;
+        if let Some(a) = m.actuator.as_mut() {
+            a.side *= k;
+        }
         m
+    }
+
+    /// [`Model::at_spacing`], refused where the rescaled model's derived
+    /// quantities underflow or overflow (e.g. a 1e200 mm model spacing
+    /// rescaled to a schedule's 3.6 mm makes the mass vanish).
+    pub fn at_spacing_checked(&self, d: f64) -> Result<Model, InputError> {
+        let m = self.at_spacing(d);
+        m.check_derived().map_err(|e| {
+            InputError::new(format!(
+                "model '{}' at the schedule's spacing {d} m: {e}",
+                self.name
+            ))
+        })?;
+        Ok(m)
     }
 
     /// The same model with another connector pressure (Pa) and bending rule.
@@ -325,6 +543,9 @@ impl Model {
         m.connector.pressure = pressure;
         m.connector.bending = bending;
         m.ground.bending = bending;
+        if let Some(a) = m.actuator.as_mut() {
+            a.bending = bending;
+        }
         m
     }
 

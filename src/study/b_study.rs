@@ -236,7 +236,7 @@ pub fn study_rows(
         };
         let bar = progress;
         bar.start(&format!("b = {b}"), (schedule.steps.len() + 1) as u64);
-        let m = model.at_spacing(schedule.spacing.metres());
+        let m = model.at_spacing_checked(schedule.spacing.metres())?;
         let mut row = Row {
             b,
             steps: schedule.steps.len(),
