@@ -10,6 +10,7 @@
 
 use super::capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};
 use super::direct::Factor;
+use super::limit::{self, Connectors};
 use super::model::{Capacity, Model};
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
@@ -35,7 +36,7 @@ pub struct LinkResult {
     pub moment: [f64; 3],
 }
 
-/// The connector holding a mover on its pivot, at its worst instant.
+/// The actuator hold of a mover on its pivot, at its worst instant.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PivotResult {
     pub hanging: usize,
@@ -70,9 +71,21 @@ pub enum Critical {
 pub struct Analysis {
     pub links: Vec<LinkResult>,
     pub pivots: Vec<PivotResult>,
-    /// Bodies of components with no support left (nothing holds them).
+    /// Bodies of components with no static equilibrium: nothing supports
+    /// them, or the limit analysis finds that they tip or slide even with
+    /// rigid connectors.
     pub unsupported: Vec<usize>,
+    /// The largest utilisation: of the connectors and ground contacts (the
+    /// elastic estimate at its worst pose, or `1/λ` of a component the
+    /// limit analysis judged) and of the actuator holds.
     pub max_utilisation: f64,
+    /// The largest utilisation of the actuator holds alone.
+    pub hold_utilisation: f64,
+    /// The smallest load factor `λ` of the components the elastic screen
+    /// could not clear (`None`: the screen cleared every one).
+    pub load_factor: Option<f64>,
+    /// Limit analyses (LP/SOCP solves) this analysis took.
+    pub limit_analyses: usize,
     pub critical: Option<Critical>,
     pub verdict: Option<Verdict>,
     /// CG iterations (preconditioned by a kept factor, or refining a fresh
@@ -87,6 +100,41 @@ impl Analysis {
     }
 }
 
+/// The elastic screen of one component.
+#[derive(Clone, Debug, Default)]
+struct Screen {
+    /// Whether some link ties the component to the ground or a fixed
+    /// module once the active set has settled (if not, the screen found
+    /// no elastic witness at all: every pose goes to the limit analysis).
+    anchored: bool,
+    /// Per link of the component, its worst result over the poses.
+    links: Vec<LinkResult>,
+    /// Poses (`None`: the reference) where some link is beyond capacity,
+    /// with their largest utilisation, worst first.
+    failing: Vec<(Option<usize>, f64)>,
+    /// The largest utilisation at the poses where every link is within
+    /// capacity (the elastic witness there).
+    admissible: f64,
+    /// Displacements at the reference pose (the next step's warm start).
+    q_reference: Vec<Vec6>,
+}
+
+/// The limit analysis of one component over the poses the screen could not
+/// clear.
+#[derive(Copy, Clone, Debug)]
+struct LimitOutcome {
+    /// With connectors rigid, the smallest factor over the failing poses:
+    /// below 1, the component tips or slides there.
+    rigid: f64,
+    /// With every link within capacity, the smallest factor over the poses
+    /// analysed (the worst of all failing poses, see [`Analyzer::limit`]):
+    /// below 1, some link must fail.
+    capacities: f64,
+    /// The screen's utilisation at the poses it cleared.
+    admissible: f64,
+    runs: usize,
+}
+
 /// Solver settings.
 #[derive(Copy, Clone, Debug)]
 pub struct Settings {
@@ -99,6 +147,10 @@ pub struct Settings {
     /// The kept factor is tried only while at most this many bodies were
     /// added or removed since it was made.
     pub reuse_max_changed: usize,
+    /// Judge every sampled pose of the movers' sweeps (the certifier's
+    /// setting). Off, only the reference pose is solved: one consistent
+    /// equilibrium, for tests of the elastic network itself.
+    pub envelope: bool,
 }
 
 impl Default for Settings {
@@ -108,6 +160,7 @@ impl Default for Settings {
             max_release_rounds: 30,
             reuse_iterations: REUSE_ITERATIONS,
             reuse_max_changed: REUSE_MAX_CHANGED,
+            envelope: true,
         }
     }
 }
@@ -187,13 +240,18 @@ fn link_stiffness(link: &Link, k: &Springs) -> Block {
     d
 }
 
-/// Loads of one structure's modules (units of `W`, moments in `W·d`).
-fn body_loads(s: &Structure) -> Vec<Vec6> {
+/// Loads of one structure's modules (units of `W`, moments in `W·d`), each
+/// mover hanging on its pivot at sample `pose` of its path, or (`None`) at
+/// its largest horizontal lever — the reference pose of the elastic screen.
+fn body_loads(s: &Structure, pose: Option<usize>) -> Vec<Vec6> {
     let g = s.gravity;
     let mut f = vec![Vec6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0); s.bodies.len()];
     for h in &s.hanging {
         let p = s.bodies[h.pivot].centre;
-        let r = worst_lever(h.path.iter().map(|c| *c - p), g);
+        let r = match pose {
+            Some(k) => h.path[k.min(h.path.len() - 1)] - p,
+            None => worst_lever(h.path.iter().map(|c| *c - p), g),
+        };
         let m = r.cross(g);
         f[h.pivot] += Vec6::new(g.x, g.y, g.z, m.x, m.y, m.z);
     }
@@ -325,102 +383,47 @@ impl Analyzer {
     }
 
     /// Analyses one structure.
+    ///
+    /// Per connected component of free bodies:
+    /// 1. **Elastic screen** ([`Analyzer::screen`]): the elastic network at
+    ///    a reference pose (each mover at its largest horizontal lever),
+    ///    ground contacts made unilateral by an active set; then, with that
+    ///    active set, every sampled pose of the movers' rotations (common
+    ///    sweep parameter `s`, as the collision check). Where every link is
+    ///    within capacity at a pose, that elastic solution is an admissible
+    ///    equilibrium: by the lower-bound theorem the component stands
+    ///    there, and its utilisations are reported.
+    /// 2. **Limit analysis** ([`super::limit`]) at every pose the screen
+    ///    could not clear: with connectors rigid (does the component stand
+    ///    on its supports at all?) and within capacities (the load factor
+    ///    `λ`). "No static equilibrium" comes only from here, or from a
+    ///    component with no support at all.
     pub fn analyse(&mut self, s: &Structure) -> Analysis {
-        let nb = s.bodies.len();
-        let loads = body_loads(s);
         let comps = Components::of_structure(s);
         let mut out = Analysis {
             links: vec![LinkResult::default(); s.links.len()],
             ..Default::default()
         };
-        let mut released = vec![false; s.links.len()];
-        let mut sliding = vec![false; s.links.len()];
-        // Displacements of every free body (zeros where unsupported).
-        let mut q_all = vec![Vec6::zeros(); nb];
-        let mut anchored = vec![false; comps.count];
-        let mut local = vec![u32::MAX; nb];
-        // The kept factors, looked up by body; this step's replace them.
         let mut kept: Vec<Option<Reference>> = std::mem::take(&mut self.references)
             .into_iter()
             .map(Some)
             .collect();
         let owner = std::mem::take(&mut self.owner);
+        let mut screens = Vec::with_capacity(comps.count);
         for c in 0..comps.count {
-            let bodies = &comps.bodies[c];
-            let links = &comps.links[c];
-            for (k, &b) in bodies.iter().enumerate() {
-                local[b] = k as u32;
-            }
-            let f: Vec<Vec6> = bodies.iter().map(|&b| loads[b]).collect();
-            let mut q: Vec<Vec6> = bodies
-                .iter()
-                .map(|&b| {
-                    self.warm
-                        .get(&key(&s.bodies[b]))
-                        .copied()
-                        .unwrap_or_else(Vec6::zeros)
-                })
-                .collect();
-            let mut reference = if self.incremental {
-                bodies
+            let reference = if self.incremental {
+                comps.bodies[c]
                     .iter()
                     .find_map(|&b| owner.get(&key(&s.bodies[b])))
                     .and_then(|&r| kept[r as usize].take())
             } else {
                 None
             };
-            for _round in 0..=self.settings.max_release_rounds {
-                // The component stands while some link ties it to the
-                // ground or to a fixed module.
-                anchored[c] = links.iter().any(|&li| {
-                    !released[li]
-                        && (comps.of(s, End::Body(s.links[li].a)).is_none()
-                            || comps.of(s, s.links[li].b).is_none())
-                });
-                if !anchored[c] {
-                    break;
-                }
-                let k = self.assemble(s, links, &local, &released, &sliding, bodies.len());
-                self.solve(s, bodies, &k, &f, &mut q, &mut reference, &mut out);
-                for (i, &b) in bodies.iter().enumerate() {
-                    q_all[b] = q[i];
-                }
-                // Ground contacts pulled or tipped beyond their edge let
-                // go; failing that, those beyond their friction slide.
-                let mut lift = Vec::new();
-                let mut slide = Vec::new();
-                for &li in links {
-                    let l = &s.links[li];
-                    if !l.is_ground() || released[li] {
-                        continue;
-                    }
-                    let load = self.link_forces(s, l, &q_all, sliding[li]).0;
-                    let (u, mode) = utilisation(&load, &self.model.ground);
-                    if overloaded(u) {
-                        match mode {
-                            Mode::Bending => lift.push(li),
-                            Mode::Friction if !sliding[li] => slide.push(li),
-                            Mode::Friction => {}
-                        }
-                    }
-                }
-                if !lift.is_empty() {
-                    lift.into_iter().for_each(|li| released[li] = true);
-                } else if !slide.is_empty() {
-                    slide.into_iter().for_each(|li| sliding[li] = true);
-                } else {
-                    break;
-                }
-            }
-            for &b in bodies {
-                local[b] = u32::MAX;
-            }
-            if !anchored[c] {
-                bodies.iter().for_each(|&b| q_all[b] = Vec6::zeros());
-            }
-            if let Some(r) = reference {
+            let (screen, reference) = self.screen(s, &comps, c, reference, &mut out);
+            if let (true, Some(r)) = (self.incremental, reference) {
                 self.references.push(r);
             }
+            screens.push(screen);
         }
         if self.incremental {
             self.warm.clear();
@@ -430,44 +433,375 @@ impl Analyzer {
                 }
             }
         }
-        let mut any_unsupported = false;
-        for c in 0..comps.count {
-            if !anchored[c] {
-                any_unsupported = true;
+        let mut limits = Vec::new();
+        for (c, screen) in screens.iter().enumerate() {
+            let supported = comps.links[c].iter().any(|&li| {
+                comps.of(s, End::Body(s.links[li].a)).is_none()
+                    || comps.of(s, s.links[li].b).is_none()
+            });
+            if !supported {
+                // Nothing ties it to the ground or a fixed module.
                 out.unsupported.extend(comps.bodies[c].iter().copied());
                 continue;
             }
             if self.incremental {
-                for &b in &comps.bodies[c] {
-                    self.warm.insert(key(&s.bodies[b]), q_all[b]);
+                for (&b, q) in comps.bodies[c].iter().zip(&screen.q_reference) {
+                    self.warm.insert(key(&s.bodies[b]), *q);
                 }
             }
-            for &li in &comps.links[c] {
+            for (&li, r) in comps.links[c].iter().zip(&screen.links) {
+                out.links[li] = *r;
+            }
+            if !screen.failing.is_empty() {
+                let mut limit = self.limit(s, &comps, c, &screen.failing);
+                limit.admissible = screen.admissible;
+                out.limit_analyses += limit.runs;
+                if limit.rigid < 1.0 || limit.rigid.is_nan() {
+                    out.unsupported.extend(comps.bodies[c].iter().copied());
+                }
+                limits.push((c, limit));
+            }
+        }
+        out.unsupported.sort_unstable();
+        out.pivots = self.holds(s);
+        self.summarise(s, &comps, &limits, &mut out);
+        out
+    }
+
+    /// The elastic screen of component `c` (see [`Analyzer::analyse`]):
+    /// per link its worst result over the poses, the poses at which some
+    /// link is beyond capacity, and the kept factor.
+    fn screen(
+        &mut self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        mut reference: Option<Reference>,
+        out: &mut Analysis,
+    ) -> (Screen, Option<Reference>) {
+        let bodies = &comps.bodies[c];
+        let links = &comps.links[c];
+        let mut local = vec![u32::MAX; s.bodies.len()];
+        for (k, &b) in bodies.iter().enumerate() {
+            local[b] = k as u32;
+        }
+        let f: Vec<Vec6> = body_loads(s, None)
+            .into_iter()
+            .enumerate()
+            .filter(|(b, _)| local[*b] != u32::MAX)
+            .map(|(_, f)| f)
+            .collect();
+        let mut q: Vec<Vec6> = bodies
+            .iter()
+            .map(|&b| {
+                self.warm
+                    .get(&key(&s.bodies[b]))
+                    .copied()
+                    .unwrap_or_else(Vec6::zeros)
+            })
+            .collect();
+        let mut released = vec![false; s.links.len()];
+        let mut sliding = vec![false; s.links.len()];
+        let mut q_all = vec![Vec6::zeros(); s.bodies.len()];
+        let mut screen = Screen::default();
+        let mut k = BlockMatrix::new(0);
+        // Whether the kept factor is that of the final `k` (made this step).
+        let mut exact = false;
+        let mut converged = true;
+        for _round in 0..=self.settings.max_release_rounds {
+            // The component stands only while some link ties it to the
+            // ground or to a fixed module.
+            screen.anchored = links.iter().any(|&li| {
+                !released[li]
+                    && (comps.of(s, End::Body(s.links[li].a)).is_none()
+                        || comps.of(s, s.links[li].b).is_none())
+            });
+            if !screen.anchored {
+                break;
+            }
+            k = self.assemble(s, links, &local, &released, &sliding, bodies.len());
+            let before = out.factorizations;
+            converged = self.solve(s, bodies, &k, &f, &mut q, &mut reference, out);
+            exact = out.factorizations > before;
+            for (i, &b) in bodies.iter().enumerate() {
+                q_all[b] = q[i];
+            }
+            // Ground contacts pulled apart let go; failing that, those
+            // beyond their friction slide.
+            let mut lift = Vec::new();
+            let mut slide = Vec::new();
+            for &li in links {
                 let l = &s.links[li];
-                out.links[li] = if released[li] {
+                if !l.is_ground() || released[li] {
+                    continue;
+                }
+                let sf = self.link_sf(s, l, &q_all, sliding[li]);
+                let load = self.load_of(l, &sf).0;
+                let (u, mode) = utilisation(&load, &self.model.ground);
+                if overloaded(u) {
+                    match mode {
+                        // Only a contact pulled apart lets go; one pressed
+                        // but tipped past its edge stays (it still bears),
+                        // and if no witness results the limit analysis
+                        // decides.
+                        Mode::Bending if load.axial > 0.0 => lift.push(li),
+                        Mode::Bending => {}
+                        Mode::Friction if !sliding[li] => slide.push(li),
+                        Mode::Friction => {}
+                    }
+                }
+            }
+            if !lift.is_empty() {
+                lift.into_iter().for_each(|li| released[li] = true);
+            } else if !slide.is_empty() {
+                slide.into_iter().for_each(|li| sliding[li] = true);
+            } else {
+                break;
+            }
+        }
+        screen.q_reference = q.clone();
+        // The poses to judge: the reference alone for a component no mover
+        // hangs on; otherwise every sampled pose of the movers' sweeps.
+        let movers: Vec<usize> = (0..s.hanging.len())
+            .filter(|&h| local[s.hanging[h].pivot] != u32::MAX)
+            .collect();
+        let n_poses = movers.iter().map(|&h| s.hanging[h].path.len()).max();
+        let poses: Vec<Option<usize>> = match n_poses {
+            Some(n) if self.settings.envelope => (0..n).map(Some).collect(),
+            _ => vec![None],
+        };
+        if !screen.anchored || !converged {
+            // The active set let go of every support, or left a mechanism
+            // CG could not balance: the elastic screen found no witness. Whether the component stands is for the
+            // limit analysis to say, at every pose.
+            screen.links = vec![LinkResult::default(); links.len()];
+            screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
+            return (screen, reference);
+        }
+        // Interface forces (6-vectors per link, in `W`, `W·d`) at a pose.
+        // The loads of a pose differ from the reference only by each
+        // mover's moment on its pivot, which lies across gravity: two unit
+        // moments per mover span every pose, so with few movers the poses
+        // are superposed from 1 + 2·movers solves instead of one each.
+        let active: Vec<usize> = links.iter().copied().filter(|&li| !released[li]).collect();
+        let sf_of = |this: &mut Self, q_all: &[Vec6]| -> Vec<Vec6> {
+            active
+                .iter()
+                .map(|&li| this.link_sf(s, &s.links[li], q_all, sliding[li]))
+                .collect()
+        };
+        let sf_reference = sf_of(self, &q_all);
+        let g = s.gravity;
+        let e1 = g.any_orthonormal_vector();
+        let e2 = g.cross(e1);
+        let superpose = poses.len() > 1 && 2 * movers.len() + 1 < poses.len();
+        // The right-hand sides: a unit moment across gravity per mover and
+        // axis, or the loads of every pose; solved together by the factor
+        // of this step's matrix (made now if the step reused an older one).
+        let mut rhs: Vec<Vec<Vec6>> = Vec::new();
+        let mut units: Vec<(usize, DVec3)> = Vec::new();
+        if superpose {
+            for &h in &movers {
+                for e in [e1, e2] {
+                    let mut f_unit = vec![Vec6::zeros(); bodies.len()];
+                    f_unit[local[s.hanging[h].pivot] as usize] =
+                        Vec6::new(0.0, 0.0, 0.0, e.x, e.y, e.z);
+                    rhs.push(f_unit);
+                    units.push((h, e));
+                }
+            }
+        } else if poses.len() > 1 {
+            for &pose in &poses {
+                rhs.push(
+                    body_loads(s, pose)
+                        .into_iter()
+                        .enumerate()
+                        .filter(|(b, _)| local[*b] != u32::MAX)
+                        .map(|(_, f)| f)
+                        .collect(),
+                );
+            }
+        }
+        if !rhs.is_empty() && !exact {
+            if let Some(factor) = Factor::new(&k) {
+                out.factorizations += 1;
+                let index = bodies
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &b)| (key(&s.bodies[b]), i as u32))
+                    .collect();
+                reference = Some(Reference { factor, index });
+                exact = true;
+            }
+        }
+        if exact && let Some(r) = reference.as_ref() {
+            r.factor.solve_many_in_place(&mut rhs);
+        } else {
+            // No factor (a mechanism, e.g. a sliding contact): one by one.
+            for f_k in &mut rhs {
+                let mut q_k = screen.q_reference.clone();
+                converged &= self.solve(s, bodies, &k, f_k, &mut q_k, &mut reference, out);
+                f_k.copy_from_slice(&q_k);
+            }
+            if !converged {
+                screen.links = vec![LinkResult::default(); links.len()];
+                screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
+                return (screen, reference);
+            }
+        }
+        // Interface forces of each solution.
+        let mut solved: Vec<Vec<Vec6>> = Vec::with_capacity(rhs.len());
+        let mut q_b = vec![Vec6::zeros(); s.bodies.len()];
+        for q_k in &rhs {
+            for (i, &b) in bodies.iter().enumerate() {
+                q_b[b] = q_k[i];
+            }
+            solved.push(sf_of(self, &q_b));
+        }
+        let basis: Vec<(usize, DVec3, Vec<Vec6>)> = if superpose {
+            units
+                .into_iter()
+                .zip(std::mem::take(&mut solved))
+                .map(|((h, e), sf)| (h, e, sf))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        // A mover's moment on its pivot at a pose, less its reference one.
+        let moment_change = |h: usize, pose: Option<usize>| -> DVec3 {
+            let hg = &s.hanging[h];
+            let p = s.bodies[hg.pivot].centre;
+            let at = |r: DVec3| r.cross(g);
+            let reference = at(worst_lever(hg.path.iter().map(|c| *c - p), g));
+            match pose {
+                Some(k) => at(hg.path[k.min(hg.path.len() - 1)] - p) - reference,
+                None => DVec3::ZERO,
+            }
+        };
+        screen.links = vec![LinkResult::default(); links.len()];
+        let mut slot = vec![usize::MAX; s.links.len()];
+        for (j, &li) in active.iter().enumerate() {
+            slot[li] = j;
+        }
+        let mut first = true;
+        for pose in poses {
+            let mixed: Vec<Vec6>;
+            let sf: &[Vec6] = match pose {
+                None => &sf_reference,
+                Some(_) if superpose => {
+                    let mut x = sf_reference.clone();
+                    for (h, e, sf_b) in &basis {
+                        let c = moment_change(*h, pose).dot(*e);
+                        if c != 0.0 {
+                            x.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
+                        }
+                    }
+                    mixed = x;
+                    &mixed
+                }
+                Some(p) => &solved[p],
+            };
+            let mut worst: f64 = 0.0;
+            for (j, &li) in links.iter().enumerate() {
+                let r = if released[li] {
                     LinkResult {
                         released: true,
                         ..Default::default()
                     }
                 } else {
-                    let (load, force, moment) = self.link_forces(s, l, &q_all, sliding[li]);
-                    let (u, m) = utilisation(&load, self.capacity(l));
-                    LinkResult {
-                        load,
-                        utilisation: u,
-                        mode: Some(m),
-                        released: false,
-                        sliding: sliding[li],
-                        force: force.to_array(),
-                        moment: moment.to_array(),
-                    }
+                    self.link_result(&s.links[li], &sf[slot[li]], sliding[li])
                 };
+                worst = worst.max(severity(r.utilisation));
+                if first || severity(r.utilisation) > severity(screen.links[j].utilisation) {
+                    screen.links[j] = r;
+                }
+            }
+            first = false;
+            if overloaded(worst) {
+                screen.failing.push((pose, worst));
+            } else {
+                screen.admissible = screen.admissible.max(worst);
             }
         }
-        out.unsupported.sort_unstable();
+        screen.failing.sort_by(|a, b| b.1.total_cmp(&a.1));
+        (screen, reference)
+    }
 
-        // The connector holding each mover on its pivot.
+    /// One link's result from its interface force `sf` (units `W`, `W·d`).
+    fn link_result(&self, l: &Link, sf: &Vec6, sliding: bool) -> LinkResult {
+        let (load, force, moment) = self.load_of(l, sf);
+        let (u, m) = utilisation(&load, self.capacity(l));
+        LinkResult {
+            load,
+            utilisation: u,
+            mode: Some(m),
+            released: false,
+            sliding,
+            force: force.to_array(),
+            moment: moment.to_array(),
+        }
+    }
+
+    /// Limit analysis of component `c` at the poses the screen could not
+    /// clear (`failing`, worst elastic utilisation first).
+    ///
+    /// With rigid connectors the component is one rigid body on its ground
+    /// contacts: a 6-equation problem, solved at every failing pose. The
+    /// problem with capacities is the costly one; it runs branch and bound
+    /// over the poses: the elastic equilibrium scaled by `1/u` is
+    /// admissible, so `1/λ ≤ u` at every pose, and once the worst `1/λ`
+    /// found reaches the next pose's elastic `u`, no later pose can exceed
+    /// it. Every pose is analysed when the component holds at all of them.
+    fn limit(
+        &self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        failing: &[(Option<usize>, f64)],
+    ) -> LimitOutcome {
+        let mut out = LimitOutcome {
+            rigid: f64::INFINITY,
+            capacities: f64::INFINITY,
+            admissible: 0.0,
+            runs: 0,
+        };
+        let part = limit::Part {
+            bodies: &comps.bodies[c],
+            links: &comps.links[c],
+        };
+        // A NaN (solver failure) sticks: it reads as overloaded everywhere.
+        let lower = |x: f64, y: f64| {
+            if x.is_nan() || y.is_nan() {
+                f64::NAN
+            } else {
+                x.min(y)
+            }
+        };
+        for &(pose, _) in failing {
+            let loads = body_loads(s, pose);
+            let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
+            // (Held by a fixed module, the rigid case needs no solve.)
+            out.runs += usize::from(rigid.iterations > 0);
+            out.rigid = lower(out.rigid, rigid.lambda);
+        }
+        for &(pose, elastic) in failing {
+            if out.capacities.is_nan() || 1.0 / out.capacities >= elastic {
+                break;
+            }
+            let loads = body_loads(s, pose);
+            let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
+            out.runs += 1;
+            out.capacities = lower(out.capacities, cap.lambda);
+        }
+        out
+    }
+
+    /// The actuator hold of each mover on its pivot, at its worst sampled
+    /// pose. A mover hangs on its pivot alone: its hold is determinate.
+    fn holds(&self, s: &Structure) -> Vec<PivotResult> {
         let w = self.model.weight();
+        let hold = self.model.hold();
+        let mut out = Vec::new();
         for (hi, h) in s.hanging.iter().enumerate() {
             let p = s.bodies[h.pivot].centre;
             let n_samples = h.path.len();
@@ -475,7 +809,7 @@ impl Analyzer {
             for (k, c) in h.path.iter().enumerate() {
                 let n = (*c - p).normalize();
                 let (u, v) = super::structure::face_frame(n);
-                // The connector holds the mover's weight: force −W·ĝ on the
+                // The hold carries the mover's weight: force −W·ĝ on the
                 // mover, moment −(c − contact) × W·ĝ with c − contact = n·r/2.
                 let g = s.gravity;
                 let r = (*c - p).length() * self.model.spacing / 2.0;
@@ -489,8 +823,11 @@ impl Analyzer {
                     moment_u: m_on_mover.dot(u),
                     moment_v: m_on_mover.dot(v),
                 };
-                let (ut, mode) = utilisation(&load, &self.model.connector);
-                if worst.as_ref().is_none_or(|w| ut > w.utilisation) {
+                let (ut, mode) = utilisation(&load, &hold);
+                if worst
+                    .as_ref()
+                    .is_none_or(|w| severity(ut) > severity(w.utilisation))
+                {
                     worst = Some(PivotResult {
                         hanging: hi,
                         load,
@@ -500,30 +837,44 @@ impl Analyzer {
                     });
                 }
             }
-            out.pivots.extend(worst);
+            out.extend(worst);
         }
+        out
+    }
 
-        // Summary.
+    /// The maxima, the critical element and the verdict.
+    fn summarise(
+        &self,
+        s: &Structure,
+        comps: &Components,
+        limits: &[(usize, LimitOutcome)],
+        out: &mut Analysis,
+    ) {
+        let limited: Vec<bool> = {
+            let mut v = vec![false; comps.count];
+            limits.iter().for_each(|(c, _)| v[*c] = true);
+            v
+        };
         let mut max = 0.0;
         let mut crit = None;
-        let mut any_overloaded = false;
-        let mut slides = false;
         for (i, r) in out.links.iter().enumerate() {
+            let side = comps
+                .of(s, End::Body(s.links[i].a))
+                .or(comps.of(s, s.links[i].b));
+            if side.is_some_and(|c| limited[c]) {
+                continue;
+            }
             let u = severity(r.utilisation);
             if u > max || (crit.is_none() && u > 0.0) {
                 max = u;
                 crit = Some(Critical::Link(i));
             }
-            if overloaded(r.utilisation) {
-                if s.links[i].is_ground() {
-                    slides = true;
-                } else {
-                    any_overloaded = true;
-                }
-            }
         }
+        let mut hold_max: f64 = 0.0;
+        let mut any_overloaded = false;
         for (i, r) in out.pivots.iter().enumerate() {
             let u = severity(r.utilisation);
+            hold_max = hold_max.max(u);
             if u > max {
                 max = u;
                 crit = Some(Critical::Pivot(i));
@@ -532,16 +883,48 @@ impl Analyzer {
                 any_overloaded = true;
             }
         }
+        let mut no_equilibrium = !out.unsupported.is_empty();
+        for (c, l) in limits {
+            // The smallest factor; a failed solve (NaN) sticks.
+            let lf = l.capacities;
+            out.load_factor = Some(match out.load_factor {
+                Some(x) if x.is_nan() => x,
+                Some(x) if !lf.is_nan() => x.min(lf),
+                _ => lf,
+            });
+            // At a failing pose the component's utilisation is 1/λ: the
+            // fraction of its capacity the best equilibrium uses; at the
+            // others, the elastic witness's.
+            let u = severity(1.0 / l.capacities).max(l.admissible);
+            if u > max || crit.is_none() {
+                max = u;
+                // The most loaded link of the elastic estimate names where.
+                crit = comps.links[*c]
+                    .iter()
+                    .copied()
+                    .max_by(|&a, &b| {
+                        severity(out.links[a].utilisation)
+                            .total_cmp(&severity(out.links[b].utilisation))
+                    })
+                    .map(Critical::Link)
+                    .or(crit);
+            }
+            if !(l.rigid >= 1.0) {
+                no_equilibrium = true;
+            } else if overloaded(1.0 / l.capacities) {
+                any_overloaded = true;
+            }
+        }
         out.max_utilisation = max;
+        out.hold_utilisation = hold_max;
         out.critical = crit;
-        out.verdict = Some(if any_unsupported || slides {
+        out.verdict = Some(if no_equilibrium {
             Verdict::NoEquilibrium
         } else if any_overloaded {
             Verdict::Overloaded
         } else {
             Verdict::Stable
         });
-        out
     }
 
     /// The stiffness matrix of every free body of `s` (in body order, fixed
@@ -575,15 +958,9 @@ impl Analyzer {
         k
     }
 
-    /// The link's load in its frame, and the force and moment side `a`
-    /// exerts on side `b` (world, SI).
-    fn link_forces(
-        &mut self,
-        s: &Structure,
-        l: &Link,
-        q: &[Vec6],
-        sliding: bool,
-    ) -> (ConnectorLoad, DVec3, DVec3) {
+    /// The interface force of a link (`D·(G_b q_b − G_a q_a)`, units `W`
+    /// and `W·d`) from the displacements `q` (every body indexed).
+    fn link_sf(&mut self, s: &Structure, l: &Link, q: &[Vec6], sliding: bool) -> Vec6 {
         let lb = self.link_blocks(s, l, sliding);
         let mut e = Vec6::zeros();
         if !s.bodies[l.a].fixed {
@@ -594,7 +971,12 @@ impl Analyzer {
         {
             e += lb.gb * q[b];
         }
-        let sf = lb.d * e;
+        lb.d * e
+    }
+
+    /// The link's load in its frame, and the force and moment side `a`
+    /// exerts on side `b` (world, SI), from its interface force `sf`.
+    fn load_of(&self, l: &Link, sf: &Vec6) -> (ConnectorLoad, DVec3, DVec3) {
         let f = DVec3::new(sf[0], sf[1], sf[2]);
         let m = DVec3::new(sf[3], sf[4], sf[5]);
         let axial = f.dot(l.normal);
@@ -651,7 +1033,8 @@ impl Analyzer {
         k
     }
 
-    /// Solves `K q = f` over one component's `active` bodies: by a fresh
+    /// Solves `K q = f` over one component's `active` bodies (returning
+    /// whether it met the tolerance: only then is `q` an equilibrium): by a fresh
     /// factor, or (incrementally) by CG preconditioned with the component's
     /// kept factor `reference`, falling back to a fresh factor — which then
     /// becomes the kept one — when that does not converge quickly.
@@ -665,12 +1048,12 @@ impl Analyzer {
         q: &mut [Vec6],
         reference: &mut Option<Reference>,
         out: &mut Analysis,
-    ) {
+    ) -> bool {
         if k.is_empty() {
-            return;
+            return true;
         }
         let tol = self.settings.tolerance;
-        if self.incremental {
+        {
             if let Some(r) = reference.as_ref() {
                 let map: Vec<u32> = active
                     .iter()
@@ -684,12 +1067,14 @@ impl Analyzer {
                     let stats = pcg(k, &mut apply, f, q, tol, self.settings.reuse_iterations);
                     out.iterations += stats.iterations;
                     if stats.converged {
-                        return;
+                        return true;
                     }
                 }
-            } else if pcg(k, &mut |r, z| z.copy_from_slice(r), f, q, tol, 0).converged {
+            } else if self.incremental
+                && pcg(k, &mut |r, z| z.copy_from_slice(r), f, q, tol, 0).converged
+            {
                 // Already at the solution (nothing changed): no factor needed.
-                return;
+                return true;
             }
         }
         let fac = Factor::new(k);
@@ -703,8 +1088,11 @@ impl Analyzer {
                     z.copy_from_slice(res);
                     factor.solve_in_place(z);
                 };
-                out.iterations += pcg(k, &mut apply, f, q, tol, 5).iterations;
-                if self.incremental {
+                let refined = pcg(k, &mut apply, f, q, tol, 5);
+                out.iterations += refined.iterations;
+                // Kept for the step's other solves (poses, release rounds),
+                // and for later steps when incremental.
+                {
                     let index = active
                         .iter()
                         .enumerate()
@@ -712,12 +1100,16 @@ impl Analyzer {
                         .collect();
                     *reference = Some(Reference { factor, index });
                 }
+                refined.converged
             }
             None => {
                 // Not positive definite (a mechanism, e.g. a contact that
                 // slides): CG finds a least-energy answer in the range.
                 let n = k.len();
-                out.iterations += jacobi_pcg(k, f, q, tol, 50 * 6 * n + 1000).iterations;
+                let stats = jacobi_pcg(k, f, q, tol, 50 * 6 * n + 1000);
+                out.iterations += stats.iterations;
+                // Unconverged, `q` is no equilibrium: no witness.
+                stats.converged
             }
         }
     }

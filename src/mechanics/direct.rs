@@ -155,6 +155,35 @@ impl Factor {
     }
 
     /// Solves `K x = b` in place (`b` has one block per row of `K`).
+    /// Solves `K x = b` for several right-hand sides at once (one pass
+    /// over the factor for all of them: the sampled poses of a step).
+    pub fn solve_many_in_place(&self, bs: &mut [Vec<Vec6>]) {
+        let m = bs.len();
+        if m == 0 {
+            return;
+        }
+        let n = 6 * self.len();
+        let mut y = vec![0.0; n * m];
+        for (j, b) in bs.iter().enumerate() {
+            assert_eq!(b.len(), self.len(), "right-hand side size");
+            for (c, &o) in self.order.iter().enumerate() {
+                y[j * n + 6 * c..j * n + 6 * c + 6].copy_from_slice(b[o].as_slice());
+            }
+        }
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(m, Par::Seq));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut y, n, m),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
+        for (j, b) in bs.iter_mut().enumerate() {
+            for (c, &o) in self.order.iter().enumerate() {
+                b[o] = Vec6::from_column_slice(&y[j * n + 6 * c..j * n + 6 * c + 6]);
+            }
+        }
+    }
+
     pub fn solve_in_place(&self, b: &mut [Vec6]) {
         assert_eq!(b.len(), self.len(), "right-hand side size");
         let mut y: Vec<f64> = self

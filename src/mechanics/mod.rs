@@ -20,6 +20,7 @@ pub(crate) mod analysis;
 pub(crate) mod capacity;
 pub(crate) mod closed_form;
 pub(crate) mod direct;
+pub(crate) mod limit;
 pub(crate) mod model;
 pub(crate) mod reuse;
 pub(crate) mod solver;
@@ -36,5 +37,7 @@ pub use structure::{SceneRef, Structure};
 /// library does not carry a physics engine it never runs.
 #[cfg(test)]
 mod dynamics;
+#[cfg(test)]
+mod resting;
 #[cfg(test)]
 mod validation;

@@ -476,15 +476,42 @@ mod tests {
             assert_eq!(r.lattice_violations, 0);
             // The worst step of growing a branch of b is the last agent
             // hanging beyond the tip of b − 1 modules: (b)² / 2 · W·d at the
-            // root — the closed form for b − 1 modules plus an agent.
+            // root — the closed form for b − 1 modules plus an agent, at the
+            // end of its swing. The envelope never reports less.
             let expected = closed_form::cantilever_utilisation(&model, r.b - 1, true);
-            assert!(
-                (r.max_utilisation - expected).abs() < 1e-6 * expected.max(1e-3),
-                "b = {}: {} vs {expected}",
-                r.b,
-                r.max_utilisation
-            );
+            assert!(r.max_utilisation >= expected * (1.0 - 1e-9), "b = {}", r.b);
+            if r.b >= 3 {
+                assert!(
+                    (r.max_utilisation - expected).abs() < 1e-6 * expected,
+                    "b = {}: {} vs {expected}",
+                    r.b,
+                    r.max_utilisation
+                );
+            }
         }
+        // At b = 2 the worst instant is mid-swing: the agent rounds the
+        // tip's corner at (1 + √½, √½, 0) d, so the root connector (contact
+        // at x = ½) carries, besides the bending (½ + ½ + √½)·W·d, the
+        // torsion √½·W·d — and torsion, held by friction over a lever of
+        // 0.38 L, is the weaker capacity. Hand statics of that pose:
+        let w = model.weight();
+        let d = model.spacing;
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let mid = crate::mechanics::ConnectorLoad {
+            axial: 0.0,
+            shear: 2.0 * w,
+            torsion: h * w * d,
+            moment_u: 0.0,
+            moment_v: (1.0 + h) * w * d,
+        };
+        let (u_mid, _) = crate::mechanics::utilisation(&mid, &model.connector);
+        let end = closed_form::cantilever_utilisation(&model, 1, true);
+        assert!(u_mid > end * 1.1, "{u_mid} vs {end}");
+        assert!(
+            (st.rows[1].max_utilisation - u_mid).abs() < 1e-6 * u_mid,
+            "{} vs {u_mid}",
+            st.rows[1].max_utilisation
+        );
         // 100 kPa rigid hinge: b² ≤ pL³/(mgd) ≈ 46.6 → b = 6 grows, 7 fails.
         assert_eq!(st.b_max, 6);
         assert!(st.rows[6].max_utilisation > 1.0 && !st.rows[6].safe());
