@@ -159,26 +159,45 @@ pub fn critical_violation(
 fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
     out.metrics
         .insert("max_utilisation".into(), a.max_utilisation);
+    if !a.pivots.is_empty() {
+        out.metrics
+            .insert("hold_utilisation".into(), a.hold_utilisation);
+    }
+    if let Some(lf) = a.load_factor.filter(|x| x.is_finite()) {
+        out.metrics.insert("load_factor".into(), lf);
+    }
+    // Where the limit analysis judged, its load factor says by how much.
+    let limit = |what: &str| match a.load_factor {
+        Some(lf) if lf.is_finite() => format!("{what} (limit analysis: load factor {lf:.3})"),
+        Some(_) => format!("{what} (limit analysis failed to solve: not certified)"),
+        None => what.to_string(),
+    };
     match a.verdict() {
         Verdict::Stable => {}
-        Verdict::Overloaded => out.violations.push(critical_violation(
-            ViolationKind::Overload,
-            step,
-            "connector overloaded",
-            s,
-            a,
-        )),
+        Verdict::Overloaded => {
+            let v = critical_violation(
+                ViolationKind::Overload,
+                step,
+                &limit("connector overloaded"),
+                s,
+                a,
+            );
+            out.violations.push(match a.load_factor {
+                Some(lf) if lf.is_finite() => v.detail("load_factor", lf),
+                _ => v,
+            });
+        }
         Verdict::NoEquilibrium => {
             let loose: Vec<ModuleId> = a.unsupported.iter().map(|&b| s.bodies[b].module).collect();
             let what = if loose.is_empty() {
                 "no static equilibrium: a ground contact slides".to_string()
             } else {
                 format!(
-                    "no static equilibrium: {} module(s) tip over or are unsupported",
+                    "no static equilibrium: {} module(s) tip over, slide or are unsupported",
                     loose.len()
                 )
             };
-            let mut v = critical_violation(ViolationKind::Unstable, step, &what, s, a);
+            let mut v = critical_violation(ViolationKind::Unstable, step, &limit(&what), s, a);
             v.modules.extend(loose.iter().take(50));
             out.violations
                 .push(v.detail("unsupported_modules", loose.len()));

@@ -18,6 +18,7 @@ use super::structure::{End, Link, Structure};
 use glam::DVec3;
 use nalgebra::Matrix3;
 use rustc_hash::FxHashMap;
+use std::sync::Arc;
 
 /// Result for one link (connector or ground contact).
 #[derive(Copy, Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -312,7 +313,7 @@ pub struct Analyzer {
     /// holds each body.
     references: Vec<Reference>,
     owner: FxHashMap<BodyKey, u32>,
-    blocks: FxHashMap<([u64; 3], bool, bool), LinkBlocks>,
+    blocks: FxHashMap<([u64; 3], bool, bool), Arc<LinkBlocks>>,
 }
 
 impl Analyzer {
@@ -341,7 +342,7 @@ impl Analyzer {
 
     /// The stiffness blocks of a link (cached by geometry: every link of a
     /// lattice direction has its contact at ±n·d/2 from both centres).
-    fn link_blocks(&mut self, s: &Structure, l: &Link, sliding: bool) -> LinkBlocks {
+    fn link_blocks(&mut self, s: &Structure, l: &Link, sliding: bool) -> Arc<LinkBlocks> {
         let ra = l.contact - s.bodies[l.a].centre;
         let rb = match l.b {
             End::Body(b) => Some(l.contact - s.bodies[b].centre),
@@ -355,21 +356,21 @@ impl Analyzer {
         let standard = (ra - 0.5 * l.normal).length() < 1e-12
             && rb.is_none_or(|r| (r + 0.5 * l.normal).length() < 1e-12);
         if standard && let Some(b) = self.blocks.get(&key) {
-            return b.clone();
+            return Arc::clone(b);
         }
         let d = link_stiffness(l, &self.link_springs(l, sliding));
         let ga = transfer(ra);
         let gb = rb.map_or(Block::identity(), transfer);
-        let b = LinkBlocks {
+        let b = Arc::new(LinkBlocks {
             kaa: ga.transpose() * d * ga,
             kbb: gb.transpose() * d * gb,
             kab: -(ga.transpose() * d * gb),
             d,
             ga,
             gb,
-        };
+        });
         if standard {
-            self.blocks.insert(key, b.clone());
+            self.blocks.insert(key, Arc::clone(&b));
         }
         b
     }
@@ -584,13 +585,37 @@ impl Analyzer {
         // moments per mover span every pose, so with few movers the poses
         // are superposed from 1 + 2·movers solves instead of one each.
         let active: Vec<usize> = links.iter().copied().filter(|&li| !released[li]).collect();
-        let sf_of = |this: &mut Self, q_all: &[Vec6]| -> Vec<Vec6> {
-            active
-                .iter()
-                .map(|&li| this.link_sf(s, &s.links[li], q_all, sliding[li]))
+        // Per active link: its blocks and its two sides' local indices.
+        let plan: Vec<(Arc<LinkBlocks>, Option<usize>, Option<usize>)> = active
+            .iter()
+            .map(|&li| {
+                let l = &s.links[li];
+                let side = |e: End| match e {
+                    End::Body(b) if local[b] != u32::MAX => Some(local[b] as usize),
+                    _ => None,
+                };
+                (
+                    self.link_blocks(s, l, sliding[li]),
+                    side(End::Body(l.a)),
+                    side(l.b),
+                )
+            })
+            .collect();
+        let sf_of = |q_local: &[Vec6]| -> Vec<Vec6> {
+            plan.iter()
+                .map(|(lb, a, b)| {
+                    let mut e = Vec6::zeros();
+                    if let Some(a) = a {
+                        e -= lb.ga * q_local[*a];
+                    }
+                    if let Some(b) = b {
+                        e += lb.gb * q_local[*b];
+                    }
+                    lb.d * e
+                })
                 .collect()
         };
-        let sf_reference = sf_of(self, &q_all);
+        let sf_reference = sf_of(&screen.q_reference);
         let g = s.gravity;
         let e1 = g.any_orthonormal_vector();
         let e2 = g.cross(e1);
@@ -650,18 +675,10 @@ impl Analyzer {
             }
         }
         // Interface forces of each solution.
-        let mut solved: Vec<Vec<Vec6>> = Vec::with_capacity(rhs.len());
-        let mut q_b = vec![Vec6::zeros(); s.bodies.len()];
-        for q_k in &rhs {
-            for (i, &b) in bodies.iter().enumerate() {
-                q_b[b] = q_k[i];
-            }
-            solved.push(sf_of(self, &q_b));
-        }
         let basis: Vec<(usize, DVec3, Vec<Vec6>)> = if superpose {
             units
                 .into_iter()
-                .zip(std::mem::take(&mut solved))
+                .zip(rhs.iter().map(|q_k| sf_of(q_k)))
                 .map(|((h, e), sf)| (h, e, sf))
                 .collect()
         } else {
@@ -683,37 +700,40 @@ impl Analyzer {
         for (j, &li) in active.iter().enumerate() {
             slot[li] = j;
         }
+        // Each pose's interface forces, one at a time (never all stored).
+        let mut sf: Vec<Vec6> = Vec::new();
         let mut first = true;
         for pose in poses {
-            let mixed: Vec<Vec6>;
-            let sf: &[Vec6] = match pose {
-                None => &sf_reference,
+            match pose {
+                None => sf.clone_from(&sf_reference),
                 Some(_) if superpose => {
-                    let mut x = sf_reference.clone();
+                    sf.clone_from(&sf_reference);
                     for (h, e, sf_b) in &basis {
                         let c = moment_change(*h, pose).dot(*e);
                         if c != 0.0 {
-                            x.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
+                            sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                         }
                     }
-                    mixed = x;
-                    &mixed
                 }
-                Some(p) => &solved[p],
-            };
+                Some(p) => sf = sf_of(&rhs[p]),
+            }
             let mut worst: f64 = 0.0;
             for (j, &li) in links.iter().enumerate() {
-                let r = if released[li] {
-                    LinkResult {
-                        released: true,
-                        ..Default::default()
+                if released[li] {
+                    if first {
+                        screen.links[j] = LinkResult {
+                            released: true,
+                            ..Default::default()
+                        };
                     }
-                } else {
-                    self.link_result(&s.links[li], &sf[slot[li]], sliding[li])
-                };
-                worst = worst.max(severity(r.utilisation));
-                if first || severity(r.utilisation) > severity(screen.links[j].utilisation) {
-                    screen.links[j] = r;
+                    continue;
+                }
+                let l = &s.links[li];
+                let (load, _, _) = self.load_of(l, &sf[slot[li]]);
+                let u = severity(utilisation(&load, self.capacity(l)).0);
+                worst = worst.max(u);
+                if first || u > severity(screen.links[j].utilisation) {
+                    screen.links[j] = self.link_result(l, &sf[slot[li]], sliding[li]);
                 }
             }
             first = false;

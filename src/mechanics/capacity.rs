@@ -27,10 +27,14 @@ use super::model::{Bending, Capacity};
 /// Torsional friction lever of a uniformly pressed square, as a fraction of
 /// `L`: the mean distance from the centre, `∫|r| dA / A` over the unit
 /// square, is exactly `(√2 + ln(1 + √2))/6 = 0.38259…` (SPEC §7 rounds it to
-/// 0.383, 0.1 % on the unsafe side). `ln(1 + √2) = asinh(1)`.
-pub fn torsion_lever() -> f64 {
-    (std::f64::consts::SQRT_2 + 1f64.asinh()) / 6.0
+/// 0.383, 0.1 % on the unsafe side). `ln(1 + √2) = asinh(1)`; the
+/// constant is that expression evaluated (checked by a test), because the
+/// utilisation is evaluated for every link at every pose.
+pub const fn torsion_lever() -> f64 {
+    TORSION_LEVER
 }
+
+const TORSION_LEVER: f64 = 0.382_597_858_232_106_3;
 
 /// Slack on the utilisation limit: solver round-off must not turn a load
 /// at exactly its capacity into an overload.
@@ -233,6 +237,8 @@ mod tests {
             torsion_lever()
         );
         assert!((torsion_lever() - 0.3826).abs() < 5e-5);
+        let exact = (std::f64::consts::SQRT_2 + 1f64.asinh()) / 6.0;
+        assert!((torsion_lever() - exact).abs() <= f64::EPSILON * exact);
     }
 
     #[test]

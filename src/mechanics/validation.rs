@@ -465,3 +465,144 @@ fn a_module_leaving_and_another_arriving_are_solved_with_the_kept_factor() {
     inc.analyse(&first);
     assert_eq!(inc.analyse(&second).factorizations, 1);
 }
+
+/// A fixed root at x = 0, free modules at x = 1 … `n`, and the mover id
+/// `n + 2` swinging about the tip from `from` to `to`.
+fn swing(n: i32, from: Cell, to: Cell, route: Route) -> Structure {
+    let mut cells: Vec<Cell> = (0..=n).map(|x| Cell::new(x, 0, 0)).collect();
+    cells.push(from);
+    let pivot = Cell::new(n, 0, 0);
+    let mover: MoverSpec = (
+        n as ModuleId + 2,
+        Some(n as ModuleId + 1),
+        Motion::Rotate {
+            from,
+            to,
+            pivot,
+            route,
+        },
+    );
+    structure(&FccLattice, None, &cells, &[0], &[mover])
+}
+
+/// The finer look: the structure with the mover held at each sampled pose
+/// in turn, one equilibrium each. Returns every pose's utilisation.
+fn per_pose(model: &Model, s: &Structure) -> Vec<f64> {
+    let n = s.hanging[0].path.len();
+    (0..n)
+        .map(|k| {
+            let mut t = s.clone();
+            t.hanging[0].path = vec![s.hanging[0].path[k]];
+            one_pose(model.clone()).analyse(&t).max_utilisation
+        })
+        .collect()
+}
+
+/// The envelope's maximum is the largest over the poses (never less), and
+/// the worst pose is `expected` (0: start, 12: middle, 24: end).
+fn assert_envelope(model: &Model, s: &Structure, expected: usize) -> f64 {
+    let poses = per_pose(model, s);
+    let (worst, max) = poses
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    assert_eq!(worst, expected, "{poses:?}");
+    let a = tight(model.clone()).analyse(s);
+    assert!(
+        (a.max_utilisation - max).abs() <= 1e-9 * max,
+        "envelope {} vs worst pose {max}",
+        a.max_utilisation
+    );
+    max
+}
+
+#[test]
+fn a_swing_whose_worst_pose_is_its_start_is_judged_there() {
+    // The case: a branch of 4 beyond the fixed root; the tip
+    // module swings 90° from +x to +y about the 4th module. At the start it
+    // is a straight cantilever of 4 modules plus the mover: 0.5420.
+    let model = Model::default_catom();
+    let s = swing(4, Cell::new(5, 0, 0), Cell::new(4, 1, 0), Route::Octagonal);
+    let max = assert_envelope(&model, &s, 0);
+    let closed = super::closed_form::cantilever_utilisation(&model, 4, true);
+    assert!((max - closed).abs() < 1e-6 * closed, "{max} vs {closed}");
+    assert!((max - 0.5420).abs() < 5e-4);
+    // At 52 kPa the start pose is beyond capacity (1.042): the step must
+    // not pass, and the load factor is that pose's.
+    let weak = model.with_connector(52e3, Bending::RigidHinge);
+    let a = tight(weak).analyse(&s);
+    assert_eq!(a.verdict(), Verdict::Overloaded);
+    assert!(
+        (a.max_utilisation - max * 100.0 / 52.0).abs() < 1e-6,
+        "{}",
+        a.max_utilisation
+    );
+    let lf = a
+        .load_factor
+        .expect("the limit analysis judged the failing poses");
+    assert!((lf - 52.0 / (100.0 * max)).abs() < 1e-6, "{lf}");
+}
+
+#[test]
+fn a_swing_whose_worst_pose_is_its_end_is_judged_there() {
+    let model = Model::default_catom();
+    let s = swing(4, Cell::new(4, 1, 0), Cell::new(5, 0, 0), Route::Octagonal);
+    assert_envelope(&model, &s, 24);
+}
+
+#[test]
+fn a_swing_whose_worst_pose_is_mid_way_is_judged_there() {
+    // The agent rolling from above onto the tip of a branch of one rounds
+    // the corner at (1 + √½, √½, 0): torsion of the root connector peaks
+    // there, above both ends (the b-study's b = 2 case).
+    let model = Model::default_catom();
+    let tip = Cell::new(1, 0, 0);
+    let s = swing(
+        1,
+        FccLattice.neighbour(tip, 4),
+        FccLattice.neighbour(tip, 0),
+        Route::Octagonal,
+    );
+    let poses = per_pose(&model, &s);
+    assert!(poses[12] > 1.1 * poses[0].max(poses[24]), "{poses:?}");
+    assert_envelope(&model, &s, 12);
+}
+
+#[test]
+fn the_actuator_hold_is_reported_apart_from_the_connectors() {
+    let model = Model::default_catom();
+    let s = swing(2, Cell::new(3, 0, 0), Cell::new(2, 1, 0), Route::Octagonal);
+    let a = tight(model.clone()).analyse(&s);
+    assert_eq!(a.pivots.len(), 1);
+    // By default the hold is the connector's: the mover alone on one face.
+    let hold = a.hold_utilisation;
+    assert!(hold > 0.0 && hold < a.max_utilisation);
+    // A weaker actuator: the hold's utilisation scales with 1/p, the
+    // connectors' do not move.
+    let mut weak = model.clone();
+    weak.actuator = Some(super::model::Capacity {
+        pressure: model.connector.pressure / 4.0,
+        ..model.connector
+    });
+    let b = tight(weak).analyse(&s);
+    assert!(
+        (b.hold_utilisation - 4.0 * hold).abs() < 1e-9 * hold,
+        "{} vs {hold}",
+        b.hold_utilisation
+    );
+    for (x, y) in a.links.iter().zip(&b.links) {
+        assert_eq!(x.utilisation, y.utilisation);
+    }
+    // Weak enough, the hold alone fails the step, named as the critical.
+    let mut feeble = model.clone();
+    feeble.actuator = Some(super::model::Capacity {
+        pressure: model.connector.pressure * hold / 2.0,
+        ..model.connector
+    });
+    let c = tight(feeble).analyse(&s);
+    assert_eq!(c.verdict(), Verdict::Overloaded);
+    assert_eq!(c.critical, Some(super::analysis::Critical::Pivot(0)));
+    assert!((c.hold_utilisation - 2.0).abs() < 1e-9);
+}

@@ -38,8 +38,9 @@ pub struct Row {
     /// Minimum connector pressure (Pa) for every step to hold, per criterion.
     pub min_pressure_rigid_hinge: f64,
     pub min_pressure_elastic: f64,
-    /// Closed form: root utilisation of a `b` cantilever with an agent at
-    /// its tip, and the pressures it needs.
+    /// Closed form: root utilisation of the branch family's worst step,
+    /// `b − 1` modules and an agent beyond the base (see
+    /// [`closed_branch_max`]), and the pressures it needs.
     pub closed_utilisation: f64,
     pub closed_pressure_rigid_hinge: f64,
     pub closed_pressure_elastic: f64,
@@ -92,9 +93,19 @@ pub struct Study {
     pub unplanned: Vec<Unplanned>,
     /// Largest studied `b` such that every `b' ≤ b` is safe (0 if none).
     pub b_max: usize,
-    /// Closed-form bound for the model (cantilever with agent at the tip).
+    /// Closed-form largest `b` of the branch family ([`closed_branch_max`]).
     pub closed_b_max: usize,
     pub sweep: Vec<SweepRow>,
+}
+
+/// The closed form in the branch family's terms: growing a branch of `b`
+/// (its first module included) beyond a fixed base, the worst step is the
+/// agent hanging beyond the tip of the `b − 1` modules already placed — a
+/// cantilever of `b − 1` modules plus the agent. So the largest `b` is one
+/// more than the longest such cantilever, and the per-row figures are
+/// those of `b − 1` modules plus the agent.
+fn closed_branch_max(model: &Model) -> usize {
+    closed_form::cantilever_max_length(model, true) + 1
 }
 
 /// A generator of one schedule per branch length `b`.
@@ -247,15 +258,15 @@ pub fn study_rows(
             no_equilibrium: false,
             min_pressure_rigid_hinge: 0.0,
             min_pressure_elastic: 0.0,
-            closed_utilisation: closed_form::cantilever_utilisation(&m, b, true),
+            closed_utilisation: closed_form::cantilever_utilisation(&m, b.saturating_sub(1), true),
             closed_pressure_rigid_hinge: closed_form::cantilever_pressure(
                 &m.with_connector(m.connector.pressure, Bending::RigidHinge),
-                b,
+                b.saturating_sub(1),
                 true,
             ),
             closed_pressure_elastic: closed_form::cantilever_pressure(
                 &m.with_connector(m.connector.pressure, Bending::Elastic),
-                b,
+                b.saturating_sub(1),
                 true,
             ),
         };
@@ -349,14 +360,10 @@ pub fn assemble(
                     r.min_pressure_rigid_hinge <= p * (1.0 + 1e-9)
                 }),
                 b_max_elastic: prefix_max(&|r: &Row| r.min_pressure_elastic <= p * (1.0 + 1e-9)),
-                closed_rigid_hinge: closed_form::cantilever_max_length(
+                closed_rigid_hinge: closed_branch_max(
                     &model.with_connector(p, Bending::RigidHinge),
-                    true,
                 ),
-                closed_elastic: closed_form::cantilever_max_length(
-                    &model.with_connector(p, Bending::Elastic),
-                    true,
-                ),
+                closed_elastic: closed_branch_max(&model.with_connector(p, Bending::Elastic)),
             }
         })
         .collect();
@@ -368,7 +375,7 @@ pub fn assemble(
         rows,
         unplanned,
         b_max,
-        closed_b_max: closed_form::cantilever_max_length(model, true),
+        closed_b_max: closed_branch_max(model),
         sweep,
     }
 }
@@ -421,7 +428,7 @@ impl Study {
         }
         let _ = writeln!(
             s,
-            "largest safe b at {} kPa ({}): {} (closed form, cantilever with agent at tip: {})",
+            "largest safe b at {} kPa ({}): {} (closed form for a branch of b: b − 1 modules and the agent beyond the base: {})",
             self.pressure_kpa,
             self.bending.name(),
             self.b_max,
@@ -514,6 +521,13 @@ mod tests {
         );
         // 100 kPa rigid hinge: b² ≤ pL³/(mgd) ≈ 46.6 → b = 6 grows, 7 fails.
         assert_eq!(st.b_max, 6);
+        // The summary's closed form counts the same weights as the family's
+        // worst step: it agrees with the data, row by row and in b_max.
+        assert_eq!(st.closed_b_max, st.b_max);
+        for r in &st.rows[2..] {
+            assert!((r.closed_utilisation - r.max_utilisation).abs() < 1e-6 * r.max_utilisation);
+        }
+        assert!(st.table().contains("largest safe b at 100 kPa (rigid-hinge): 6 (closed form for a branch of b: b − 1 modules and the agent beyond the base: 6)"), "{}", st.table());
         assert!(st.rows[6].max_utilisation > 1.0 && !st.rows[6].safe());
         // At the minimum pressure the worst step is exactly at capacity.
         let r = &st.rows[5];
