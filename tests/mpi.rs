@@ -10,6 +10,7 @@ fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_reconfcheck")
 }
 
+#[cfg_attr(not(feature = "mpi"), allow(dead_code))]
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("reconfcheck-mpi-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -32,6 +33,7 @@ fn mpirun(n: usize, args: &[&str]) -> Output {
         .expect("mpirun (Open MPI) is installed: .ci/setup installs it")
 }
 
+#[cfg_attr(not(feature = "mpi"), allow(dead_code))]
 fn alone(args: &[&str]) -> Output {
     Command::new(bin())
         .args(args)

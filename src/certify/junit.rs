@@ -127,7 +127,10 @@ mod tests {
 
     /// Reads back, with an independent parser, (element, attributes) of
     /// every element in document order, and the text inside failures.
-    fn parse(xml: &str) -> (Vec<(String, Vec<(String, String)>)>, Vec<String>) {
+    /// (element name, its attributes) in document order.
+    type Elements = Vec<(String, Vec<(String, String)>)>;
+
+    fn parse(xml: &str) -> (Elements, Vec<String>) {
         let doc = roxmltree::Document::parse(xml).expect("well-formed XML");
         let mut tags = Vec::new();
         let mut texts = Vec::new();

@@ -356,6 +356,25 @@ mod tests {
             v[0].message
         );
         assert!(v[0].detail["utilisation"].as_f64().unwrap() > 1.0);
+        // The limit analysis judged it: a determinate branch carries 1/u
+        // times its weight, and the report says so.
+        let lf = v[0].detail["load_factor"].as_f64().unwrap();
+        let u = r.per_step[0].metrics["max_utilisation"];
+        assert!((lf * u - 1.0).abs() < 1e-6, "λ = {lf}, u = {u}");
+        assert!(
+            v[0].message.contains("limit analysis: load factor"),
+            "{}",
+            v[0].message
+        );
+        assert_eq!(r.per_step[0].metrics["load_factor"], lf);
+        assert!(r.per_step[0].metrics["hold_utilisation"] > 0.0);
+        assert!(
+            r.summary().contains(&format!(
+                "lowest load_factor over the steps: {lf:.4} (step 1)"
+            )),
+            "{}",
+            r.summary()
+        );
     }
 
     #[test]

@@ -597,7 +597,8 @@ mod tests {
     fn non_finite_model_numbers_never_certify_a_structure() {
         use crate::mechanics::Model;
         let s = crate::algorithms::branch::branch_schedule(3, 3.6).unwrap();
-        let edits: [(&str, fn(&mut Model)); 6] = [
+        type Edit = (&'static str, fn(&mut Model));
+        let edits: [Edit; 6] = [
             ("mass NaN", |m| {
                 m.density = None;
                 m.mass = f64::NAN

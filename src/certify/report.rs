@@ -221,17 +221,31 @@ impl Report {
                 );
             }
         }
+        // Each metric's worst step: the highest, but for a load factor the
+        // lowest (the step nearest to collapse).
+        let lowest_is_worst = |k: &str| k == "load_factor";
         let mut metrics: BTreeMap<&str, (f64, usize)> = BTreeMap::new();
         for r in &self.per_step {
             for (k, &v) in &r.metrics {
-                let e = metrics.entry(k.as_str()).or_insert((f64::NEG_INFINITY, 0));
-                if v > e.0 {
+                let low = lowest_is_worst(k);
+                let start = if low {
+                    f64::INFINITY
+                } else {
+                    f64::NEG_INFINITY
+                };
+                let e = metrics.entry(k.as_str()).or_insert((start, 0));
+                if (low && v < e.0) || (!low && v > e.0) {
                     *e = (v, r.step);
                 }
             }
         }
         for (k, (v, step)) in metrics {
-            let _ = writeln!(s, "highest {k} over the steps: {v:.4} (step {step})");
+            let which = if lowest_is_worst(k) {
+                "lowest"
+            } else {
+                "highest"
+            };
+            let _ = writeln!(s, "{which} {k} over the steps: {v:.4} (step {step})");
         }
         s
     }

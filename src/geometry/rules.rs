@@ -584,8 +584,8 @@ mod tests {
     #[test]
     fn derivation_respects_the_lattice_symmetry() {
         let o = Cell::new(0, 0, 0);
-        let mut classes: std::collections::BTreeMap<(Route, bool), Vec<(usize, usize, usize)>> =
-            Default::default();
+        type Class = Vec<(usize, usize, usize)>;
+        let mut classes: std::collections::BTreeMap<(Route, bool), Class> = Default::default();
         for r in &table().links {
             let target = Offset::between(o, FccLattice.neighbour(o, r.link.to as usize));
             let blocking = r.blocking().filter(|b| *b != target).count();

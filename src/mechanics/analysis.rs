@@ -647,8 +647,11 @@ impl Analyzer {
                 );
             }
         }
-        if !rhs.is_empty() && !exact {
-            if let Some(factor) = Factor::new(&k) {
+        if !rhs.is_empty()
+            && !exact
+            && let Some(factor) = Factor::new(&k)
+        {
+            {
                 out.factorizations += 1;
                 let index = bodies
                     .iter()
@@ -912,6 +915,12 @@ impl Analyzer {
                 Some(x) if !lf.is_nan() => x.min(lf),
                 _ => lf,
             });
+            if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
+                // It tips or slides: no equilibrium to take a utilisation
+                // of (as for a floating part), whatever 1/λ's round-off.
+                no_equilibrium = true;
+                continue;
+            }
             // At a failing pose the component's utilisation is 1/λ: the
             // fraction of its capacity the best equilibrium uses; at the
             // others, the elastic witness's.
@@ -929,9 +938,7 @@ impl Analyzer {
                     .map(Critical::Link)
                     .or(crit);
             }
-            if !(l.rigid >= 1.0) {
-                no_equilibrium = true;
-            } else if overloaded(1.0 / l.capacities) {
+            if overloaded(1.0 / l.capacities) {
                 any_overloaded = true;
             }
         }
@@ -1169,7 +1176,7 @@ impl Components {
         let mut id = vec![u32::MAX; nb];
         let mut of = vec![u32::MAX; nb];
         let mut count = 0;
-        for i in 0..nb {
+        for (i, o) in of.iter_mut().enumerate() {
             if s.bodies[i].fixed {
                 continue;
             }
@@ -1178,7 +1185,7 @@ impl Components {
                 id[r] = count as u32;
                 count += 1;
             }
-            of[i] = id[r];
+            *o = id[r];
         }
         let mut bodies = vec![Vec::new(); count];
         for i in 0..nb {

@@ -422,7 +422,7 @@ impl Model {
             actuator,
             poisson: nu,
         };
-        m.check_derived().map_err(|e| bad(e))?;
+        m.check_derived().map_err(bad)?;
         Ok(m)
     }
 

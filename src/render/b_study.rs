@@ -65,7 +65,7 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
             .collect();
         c.draw_series(LineSeries::new(closed, RED.stroke_width(1)))
             .map_err(draw_err)?
-            .label("closed form: cantilever + agent at tip")
+            .label("closed form: branch of b (b − 1 modules + agent)")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RED.stroke_width(1)));
         c.configure_series_labels()
             .background_style(WHITE.mix(0.8))

@@ -105,8 +105,17 @@ pub struct Study {
 /// more than the longest such cantilever, and the per-row figures are
 /// those of `b − 1` modules plus the agent.
 fn closed_branch_max(model: &Model) -> usize {
-    closed_form::cantilever_max_length(model, true) + 1
+    if closed_form::cantilever_utilisation(model, 0, true) <= 1.0 {
+        closed_form::cantilever_max_length(model, true) + 1
+    } else {
+        // Not even the first agent holds on the base.
+        0
+    }
 }
+
+/// The rows of the studied b, those the generator could not plan, and the
+/// first generator error (see [`study_rows`]).
+pub type StudyRows = (Vec<Row>, Vec<Unplanned>, Option<InputError>);
 
 /// A generator of one schedule per branch length `b`.
 pub type FamilyFn = Box<dyn Fn(usize) -> Result<Schedule, InputError>>;
@@ -229,7 +238,7 @@ pub fn study_rows(
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
-) -> Result<(Vec<Row>, Vec<Unplanned>, Option<InputError>), InputError> {
+) -> Result<StudyRows, InputError> {
     let mut rows = Vec::new();
     let mut unplanned = Vec::new();
     let mut first_error = None;
@@ -536,6 +545,9 @@ mod tests {
         assert!((u - 1.0).abs() < 1e-6, "{u}");
         // The sweep is monotone and matches the table at 100 kPa.
         let at100 = st.sweep.iter().find(|w| w.pressure_kpa == 100.0).unwrap();
+        // Where not even b = 1 holds, the closed form says so too.
+        let at1 = st.sweep.iter().find(|w| w.pressure_kpa == 1.0).unwrap();
+        assert_eq!((at1.b_max_rigid_hinge, at1.closed_rigid_hinge), (0, 0));
         assert_eq!(at100.b_max_rigid_hinge, 6);
         assert!(at100.b_max_elastic < 6);
         assert!(

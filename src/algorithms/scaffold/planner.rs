@@ -44,10 +44,10 @@ fn rotation_table() -> [[&'static [Route]; 12]; 12] {
     const NINETY: &[Route] = &[Route::Octagonal];
     const NONE: &[Route] = &[];
     let mut t = [[NONE; 12]; 12];
-    for f in 0..12 {
-        for g in 0..12 {
+    for (f, row) in t.iter_mut().enumerate() {
+        for (g, cell) in row.iter_mut().enumerate() {
             let dot = fcc::direction(f).dot(fcc::direction(g));
-            t[f][g] = if (dot - 0.5).abs() < 1e-9 {
+            *cell = if (dot - 0.5).abs() < 1e-9 {
                 SIXTY
             } else if dot.abs() < 1e-9 {
                 NINETY
