@@ -8,7 +8,7 @@
 //! `W = m·g`; interface stiffnesses relative to the axial one (the absolute
 //! modulus and layer thickness cancel out of the loads). Results are in SI.
 
-use super::capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};
+use super::capacity::{ConnectorLoad, Mode, corner_ratio, overloaded, severity, utilisation};
 use super::direct::Factor;
 use super::limit::{self, Connectors};
 use super::model::{Capacity, Model};
@@ -152,6 +152,10 @@ pub struct Settings {
     /// setting). Off, only the reference pose is solved: one consistent
     /// equilibrium, for tests of the elastic network itself.
     pub envelope: bool,
+    /// Require an elastic witness to be carried by the limit analysis's
+    /// corner forces too ([`corner_ratio`]). Off only to measure what the
+    /// gate changes.
+    pub corner_gate: bool,
 }
 
 impl Default for Settings {
@@ -162,6 +166,7 @@ impl Default for Settings {
             reuse_iterations: REUSE_ITERATIONS,
             reuse_max_changed: REUSE_MAX_CHANGED,
             envelope: true,
+            corner_gate: true,
         }
     }
 }
@@ -721,6 +726,10 @@ impl Analyzer {
                 Some(p) => sf = sf_of(&rhs[p]),
             }
             let mut worst: f64 = 0.0;
+            let mut gate: f64 = 0.0;
+            // The smallest down-scaling of the elastic forces the corners
+            // carry everywhere: an upper bound of 1/λ (branch and bound).
+            let mut scale: f64 = 0.0;
             for (j, &li) in links.iter().enumerate() {
                 if released[li] {
                     if first {
@@ -733,15 +742,36 @@ impl Analyzer {
                 }
                 let l = &s.links[li];
                 let (load, _, _) = self.load_of(l, &sf[slot[li]]);
-                let u = severity(utilisation(&load, self.capacity(l)).0);
+                let cap = self.capacity(l);
+                let u = severity(utilisation(&load, cap).0);
                 worst = worst.max(u);
+                // A witness must also be carried by the limit analysis's
+                // corner forces (torsion on a square pressed off-centre).
+                let r = severity(corner_ratio(&load, cap));
+                if self.settings.corner_gate && overloaded(r) {
+                    gate = gate.max(r);
+                    // The elastic forces scaled down by `k` keep the centre
+                    // of pressure no further out and the clamp at
+                    // `pL² − N/k`: the corners carry them from
+                    // `k = r − (r − 1)·N/pL²` (none for a contact without
+                    // adhesion, where scaling changes no ratio).
+                    let p = cap.tension();
+                    scale = scale.max(if p > 0.0 {
+                        r - (r - 1.0) * load.axial / p
+                    } else {
+                        f64::INFINITY
+                    });
+                }
                 if first || u > severity(screen.links[j].utilisation) {
                     screen.links[j] = self.link_result(l, &sf[slot[li]], sliding[li]);
                 }
             }
             first = false;
-            if overloaded(worst) {
-                screen.failing.push((pose, worst));
+            if overloaded(worst) || overloaded(gate) {
+                // Branch and bound needs an upper bound of 1/λ: the
+                // utilisation where the corners carry the forces, else the
+                // scaling at which they do.
+                screen.failing.push((pose, worst.max(severity(scale))));
             } else {
                 screen.admissible = screen.admissible.max(worst);
             }
@@ -774,7 +804,8 @@ impl Analyzer {
     /// over the poses: the elastic equilibrium scaled by `1/u` is
     /// admissible, so `1/λ ≤ u` at every pose, and once the worst `1/λ`
     /// found reaches the next pose's elastic `u`, no later pose can exceed
-    /// it. Every pose is analysed when the component holds at all of them.
+    /// it. Every pose is analysed when the component holds at all of them;
+    /// once one fails, the rest count at their bounds (conservative).
     fn limit(
         &self,
         s: &Structure,
@@ -807,14 +838,24 @@ impl Analyzer {
             out.runs += usize::from(rigid.iterations > 0);
             out.rigid = lower(out.rigid, rigid.lambda);
         }
-        for &(pose, elastic) in failing {
-            if out.capacities.is_nan() || 1.0 / out.capacities >= elastic {
+        for (i, &(pose, bound)) in failing.iter().enumerate() {
+            if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
             }
             let loads = body_loads(s, pose);
             let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
             out.runs += 1;
             out.capacities = lower(out.capacities, cap.lambda);
+            if !(cap.lambda >= 1.0) {
+                // The step fails here. The poses not analysed are counted
+                // at their bounds: the factor reported is then a lower
+                // bound of the true smallest (1/λ an upper bound), never
+                // more optimistic.
+                if let Some(&(_, next)) = failing.get(i + 1) {
+                    out.capacities = lower(out.capacities, 1.0 / next);
+                }
+                break;
+            }
         }
         out
     }

@@ -132,6 +132,60 @@ pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
     }
 }
 
+/// Whether the corner forces of the limit analysis ([`super::limit`]) can
+/// carry `load`, as a ratio (≤ 1: they can). The utilisation's friction
+/// chord treats torsion apart from where the square bears; the corner
+/// model couples them (a square pressed on one edge resists little
+/// torsion). An elastic solution is a witness for the limit analysis only
+/// where this holds too.
+///
+/// Sufficient, by construction: spread the clamp `C = pL² − N` over the
+/// four corners bilinearly so that its centroid is the centre of pressure
+/// `e` (`|e_u| = |M_v|/C`, `|e_v| = |M_u|/C`; non-negative whenever the
+/// bending is within capacity), give each corner the share `c_i/C` of the
+/// shear and a torsion part `k·c_i·ẑ×(r_i − e)` with `k = T'/J`,
+/// `J = Σ c_i|r_i − e|²` and `T' = T − (e × V)·n` (bounded here by
+/// `|T| + |e|·|V|`, the shear's direction being unknown). Every corner is
+/// then within its cone `‖t_i‖ ≤ μ c_i` when
+/// `|V| + (|T| + |e||V|)·ρ·C/J ≤ μC`, `ρ` the largest `|r_i − e|` of a
+/// loaded corner. Centred, the torsion lever is `L/√2`, above the chord's
+/// `0.383 L`.
+pub fn corner_ratio(load: &ConnectorLoad, cap: &Capacity) -> f64 {
+    let a = cap.side / 2.0;
+    let clamp = cap.tension() - load.axial;
+    let (v, t) = (load.shear.abs(), load.torsion.abs());
+    if v == 0.0 && t == 0.0 {
+        return 0.0;
+    }
+    if !(clamp > 0.0) || !(cap.friction > 0.0) {
+        return f64::INFINITY;
+    }
+    let (eu, ev) = (load.moment_v.abs() / clamp, load.moment_u.abs() / clamp);
+    if eu > a || ev > a {
+        // Bending beyond the square: no clamp distribution exists.
+        return f64::INFINITY;
+    }
+    let mut j = 0.0;
+    let mut rho: f64 = 0.0;
+    for (su, sv) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+        let c = clamp / 4.0 * (1.0 + su * eu / a) * (1.0 + sv * ev / a);
+        let d2 = (su * a - eu).powi(2) + (sv * a - ev).powi(2);
+        j += c * d2;
+        if c > 0.0 {
+            rho = rho.max(d2.sqrt());
+        }
+    }
+    let torsion = t + eu.hypot(ev) * v;
+    let demand = if torsion == 0.0 {
+        v
+    } else if j > 0.0 {
+        v + torsion * rho * clamp / j
+    } else {
+        f64::INFINITY
+    };
+    demand / (cap.friction * clamp)
+}
+
 /// The smallest adhesion pressure (Pa) at which `load` is within capacity
 /// (utilisation ≤ 1), other parameters unchanged: every criterion is
 /// `demand ≤ p·L² + compression`, so it is solved in closed form.
@@ -217,6 +271,96 @@ mod tests {
             ..Default::default()
         };
         assert!(utilisation(&lifted, &c).0.is_infinite());
+    }
+
+    #[test]
+    fn the_corner_ratio_is_the_corner_construction_and_tightens_off_centre() {
+        let cap = Capacity {
+            pressure: 100e3,
+            side: 1e-3,
+            friction: 0.5,
+            bending: Bending::RigidHinge,
+        };
+        let c = cap.tension();
+        // Centred, pure torsion: the lever is L/√2.
+        let t = ConnectorLoad {
+            torsion: 0.5 * c * 1e-3 / std::f64::consts::SQRT_2,
+            ..Default::default()
+        };
+        assert!((corner_ratio(&t, &cap) - 1.0).abs() < 1e-12);
+        // The same torsion with the clamp pushed towards an edge needs more.
+        let off = ConnectorLoad {
+            moment_u: 0.4 * c * 0.5e-3,
+            ..t
+        };
+        assert!(corner_ratio(&off, &cap) > 1.2);
+        // At a corner nothing resists torsion; beyond the square, nothing.
+        let corner = ConnectorLoad {
+            moment_u: c * 0.5e-3,
+            moment_v: c * 0.5e-3,
+            ..t
+        };
+        assert!(corner_ratio(&corner, &cap).is_infinite());
+        // Random loads: wherever the ratio is ≤ 1, the construction gives
+        // corner forces within their cones that add up to the load.
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let a = cap.side / 2.0;
+        let mut checked = 0;
+        for _ in 0..20_000 {
+            let n = (rnd() * 2.0 - 1.5) * c;
+            let clamp = c - n;
+            let (eu, ev) = ((rnd() * 2.0 - 1.0) * a, (rnd() * 2.0 - 1.0) * a);
+            let phi = rnd() * std::f64::consts::TAU;
+            let vmag = rnd() * 0.5 * clamp;
+            let v = (vmag * phi.cos(), vmag * phi.sin());
+            let torsion = (rnd() * 2.0 - 1.0) * 0.3 * clamp * a;
+            let load = ConnectorLoad {
+                axial: n,
+                shear: vmag,
+                torsion,
+                moment_u: ev * clamp,
+                moment_v: eu * clamp,
+            };
+            if corner_ratio(&load, &cap) > 1.0 {
+                continue;
+            }
+            checked += 1;
+            let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+            let cs: Vec<f64> = corners
+                .iter()
+                .map(|(su, sv)| clamp / 4.0 * (1.0 + su * eu / a) * (1.0 + sv * ev / a))
+                .collect();
+            let j: f64 = corners
+                .iter()
+                .zip(&cs)
+                .map(|((su, sv), ci)| ci * ((su * a - eu).powi(2) + (sv * a - ev).powi(2)))
+                .sum();
+            let t_prime = torsion - (eu * v.1 - ev * v.0);
+            let k = if j > 0.0 { t_prime / j } else { 0.0 };
+            let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
+            for ((su, sv), ci) in corners.iter().zip(&cs) {
+                let (rx, ry) = (su * a, sv * a);
+                let (dx, dy) = (rx - eu, ry - ev);
+                let tx = v.0 * ci / clamp - k * ci * dy;
+                let ty = v.1 * ci / clamp + k * ci * dx;
+                assert!(
+                    tx.hypot(ty) <= cap.friction * ci * (1.0 + 1e-9) + 1e-15,
+                    "{load:?}"
+                );
+                fx += tx;
+                fy += ty;
+                mz += rx * ty - ry * tx;
+            }
+            assert!((fx - v.0).abs() < 1e-9 * clamp && (fy - v.1).abs() < 1e-9 * clamp);
+            assert!((mz - torsion).abs() < 1e-9 * clamp * a, "{mz} vs {torsion}");
+        }
+        assert!(checked > 1000, "{checked}");
     }
 
     #[test]
