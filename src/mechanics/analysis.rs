@@ -846,7 +846,7 @@ impl Analyzer {
             let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
             out.runs += 1;
             out.capacities = lower(out.capacities, cap.lambda);
-            if !(cap.lambda >= 1.0) {
+            if cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // The step fails here. The poses not analysed are counted
                 // at their bounds: the factor reported is then a lower
                 // bound of the true smallest (1/λ an upper bound), never

@@ -157,7 +157,10 @@ pub fn corner_ratio(load: &ConnectorLoad, cap: &Capacity) -> f64 {
     if v == 0.0 && t == 0.0 {
         return 0.0;
     }
-    if !(clamp > 0.0) || !(cap.friction > 0.0) {
+    // (NaN fails these: no finite ratio.)
+    if clamp.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        || cap.friction.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
         return f64::INFINITY;
     }
     let (eu, ev) = (load.moment_v.abs() / clamp, load.moment_u.abs() / clamp);
