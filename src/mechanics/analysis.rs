@@ -104,20 +104,44 @@ impl Analysis {
 /// The elastic screen of one component.
 #[derive(Clone, Debug, Default)]
 struct Screen {
-    /// Whether some link ties the component to the ground or a fixed
-    /// module once the active set has settled (if not, the screen found
-    /// no elastic witness at all: every pose goes to the limit analysis).
-    anchored: bool,
     /// Per link of the component, its worst result over the poses.
     links: Vec<LinkResult>,
-    /// Poses (`None`: the reference) where some link is beyond capacity,
-    /// with their largest utilisation, worst first.
+    /// Poses (`None`: the reference) where the elastic field is no witness,
+    /// with an upper bound of `1/λ` there, worst first.
     failing: Vec<(Option<usize>, f64)>,
     /// The largest utilisation at the poses where every link is within
     /// capacity (the elastic witness there).
     admissible: f64,
     /// Displacements at the reference pose (the next step's warm start).
     q_reference: Vec<Vec6>,
+}
+
+/// The settled elastic equilibrium of one component (see
+/// [`Analyzer::settle`]).
+struct Settled {
+    k: BlockMatrix,
+    /// Displacements at the reference pose.
+    q: Vec<Vec6>,
+    released: Vec<bool>,
+    sliding: Vec<bool>,
+    /// Some link still ties the component to the ground or a fixed module.
+    anchored: bool,
+    /// The last solve met its tolerance (only then is `q` an equilibrium).
+    converged: bool,
+    /// The kept factor is that of `k` (made this step).
+    exact: bool,
+}
+
+/// One pose's verdict from the elastic field.
+#[derive(Copy, Clone, Debug, Default)]
+struct Judged {
+    /// The largest utilisation.
+    worst: f64,
+    /// The largest corner ratio beyond 1 (0: the corners carry it all).
+    gate: f64,
+    /// The down-scaling from which the corners carry it (an upper bound
+    /// of `1/λ`).
+    scale: f64,
 }
 
 /// The limit analysis of one component over the poses the screen could not
@@ -262,6 +286,29 @@ fn body_loads(s: &Structure, pose: Option<usize>) -> Vec<Vec6> {
         f[h.pivot] += Vec6::new(g.x, g.y, g.z, m.x, m.y, m.z);
     }
     f
+}
+
+/// [`body_loads`] of the bodies with a `local` index, in that order.
+fn local_loads(s: &Structure, pose: Option<usize>, local: &[u32]) -> Vec<Vec6> {
+    body_loads(s, pose)
+        .into_iter()
+        .enumerate()
+        .filter(|(b, _)| local[*b] != u32::MAX)
+        .map(|(_, f)| f)
+        .collect()
+}
+
+/// Mover `h`'s moment on its pivot at `pose`, less its reference one.
+fn moment_change(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
+    let hg = &s.hanging[h];
+    let p = s.bodies[hg.pivot].centre;
+    let g = s.gravity;
+    let at = |r: DVec3| r.cross(g);
+    let reference = at(worst_lever(hg.path.iter().map(|c| *c - p), g));
+    match pose {
+        Some(k) => at(hg.path[k.min(hg.path.len() - 1)] - p) - reference,
+        None => DVec3::ZERO,
+    }
 }
 
 /// The offset with the largest horizontal lever (component across gravity);
@@ -475,8 +522,9 @@ impl Analyzer {
     }
 
     /// The elastic screen of component `c` (see [`Analyzer::analyse`]):
-    /// per link its worst result over the poses, the poses at which some
-    /// link is beyond capacity, and the kept factor.
+    /// per link its worst result over the poses, the poses at which the
+    /// elastic field is no witness (with an upper bound of `1/λ` there),
+    /// and the kept factor.
     fn screen(
         &mut self,
         s: &Structure,
@@ -491,81 +539,11 @@ impl Analyzer {
         for (k, &b) in bodies.iter().enumerate() {
             local[b] = k as u32;
         }
-        let f: Vec<Vec6> = body_loads(s, None)
-            .into_iter()
-            .enumerate()
-            .filter(|(b, _)| local[*b] != u32::MAX)
-            .map(|(_, f)| f)
-            .collect();
-        let mut q: Vec<Vec6> = bodies
-            .iter()
-            .map(|&b| {
-                self.warm
-                    .get(&key(&s.bodies[b]))
-                    .copied()
-                    .unwrap_or_else(Vec6::zeros)
-            })
-            .collect();
-        let mut released = vec![false; s.links.len()];
-        let mut sliding = vec![false; s.links.len()];
-        let mut q_all = vec![Vec6::zeros(); s.bodies.len()];
-        let mut screen = Screen::default();
-        let mut k = BlockMatrix::new(0);
-        // Whether the kept factor is that of the final `k` (made this step).
-        let mut exact = false;
-        let mut converged = true;
-        for _round in 0..=self.settings.max_release_rounds {
-            // The component stands only while some link ties it to the
-            // ground or to a fixed module.
-            screen.anchored = links.iter().any(|&li| {
-                !released[li]
-                    && (comps.of(s, End::Body(s.links[li].a)).is_none()
-                        || comps.of(s, s.links[li].b).is_none())
-            });
-            if !screen.anchored {
-                break;
-            }
-            k = self.assemble(s, links, &local, &released, &sliding, bodies.len());
-            let before = out.factorizations;
-            converged = self.solve(s, bodies, &k, &f, &mut q, &mut reference, out);
-            exact = out.factorizations > before;
-            for (i, &b) in bodies.iter().enumerate() {
-                q_all[b] = q[i];
-            }
-            // Ground contacts pulled apart let go; failing that, those
-            // beyond their friction slide.
-            let mut lift = Vec::new();
-            let mut slide = Vec::new();
-            for &li in links {
-                let l = &s.links[li];
-                if !l.is_ground() || released[li] {
-                    continue;
-                }
-                let sf = self.link_sf(s, l, &q_all, sliding[li]);
-                let load = self.load_of(l, &sf).0;
-                let (u, mode) = utilisation(&load, &self.model.ground);
-                if overloaded(u) {
-                    match mode {
-                        // Only a contact pulled apart lets go; one pressed
-                        // but tipped past its edge stays (it still bears),
-                        // and if no witness results the limit analysis
-                        // decides.
-                        Mode::Bending if load.axial > 0.0 => lift.push(li),
-                        Mode::Bending => {}
-                        Mode::Friction if !sliding[li] => slide.push(li),
-                        Mode::Friction => {}
-                    }
-                }
-            }
-            if !lift.is_empty() {
-                lift.into_iter().for_each(|li| released[li] = true);
-            } else if !slide.is_empty() {
-                slide.into_iter().for_each(|li| sliding[li] = true);
-            } else {
-                break;
-            }
-        }
-        screen.q_reference = q.clone();
+        let mut st = self.settle(s, comps, c, &local, &mut reference, out);
+        let mut screen = Screen {
+            q_reference: st.q.clone(),
+            ..Default::default()
+        };
         // The poses to judge: the reference alone for a component no mover
         // hangs on; otherwise every sampled pose of the movers' sweeps.
         let movers: Vec<usize> = (0..s.hanging.len())
@@ -576,21 +554,26 @@ impl Analyzer {
             Some(n) if self.settings.envelope => (0..n).map(Some).collect(),
             _ => vec![None],
         };
-        if !screen.anchored || !converged {
-            // The active set let go of every support, or left a mechanism
-            // CG could not balance: the elastic screen found no witness. Whether the component stands is for the
-            // limit analysis to say, at every pose.
+        let no_witness = |screen: &mut Screen, poses: Vec<Option<usize>>| {
+            // Whether the component stands is for the limit analysis to
+            // say, at every pose.
             screen.links = vec![LinkResult::default(); links.len()];
             screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
+        };
+        if !st.anchored || !st.converged {
+            // The active set let go of every support, or left a mechanism
+            // CG could not balance: the elastic screen found no witness.
+            no_witness(&mut screen, poses);
             return (screen, reference);
         }
-        // Interface forces (6-vectors per link, in `W`, `W·d`) at a pose.
-        // The loads of a pose differ from the reference only by each
-        // mover's moment on its pivot, which lies across gravity: two unit
-        // moments per mover span every pose, so with few movers the poses
-        // are superposed from 1 + 2·movers solves instead of one each.
-        let active: Vec<usize> = links.iter().copied().filter(|&li| !released[li]).collect();
-        // Per active link: its blocks and its two sides' local indices.
+        // Per active link: its blocks and its two sides' local indices, so
+        // that interface forces (6-vectors in `W`, `W·d`) follow from any
+        // local displacement vector.
+        let active: Vec<usize> = links
+            .iter()
+            .copied()
+            .filter(|&li| !st.released[li])
+            .collect();
         let plan: Vec<(Arc<LinkBlocks>, Option<usize>, Option<usize>)> = active
             .iter()
             .map(|&li| {
@@ -600,7 +583,7 @@ impl Analyzer {
                     _ => None,
                 };
                 (
-                    self.link_blocks(s, l, sliding[li]),
+                    self.link_blocks(s, l, st.sliding[li]),
                     side(End::Body(l.a)),
                     side(l.b),
                 )
@@ -620,164 +603,269 @@ impl Analyzer {
                 })
                 .collect()
         };
-        let sf_reference = sf_of(&screen.q_reference);
-        let g = s.gravity;
-        let e1 = g.any_orthonormal_vector();
-        let e2 = g.cross(e1);
+        let sf_reference = sf_of(&st.q);
+        // The loads of a pose differ from the reference only by each
+        // mover's moment on its pivot, which lies across gravity: two unit
+        // moments per mover span every pose, so with few movers the poses
+        // are superposed from 2·movers solutions instead of one each.
         let superpose = poses.len() > 1 && 2 * movers.len() + 1 < poses.len();
-        // The right-hand sides: a unit moment across gravity per mover and
-        // axis, or the loads of every pose; solved together by the factor
-        // of this step's matrix (made now if the step reused an older one).
-        let mut rhs: Vec<Vec<Vec6>> = Vec::new();
-        let mut units: Vec<(usize, DVec3)> = Vec::new();
-        if superpose {
-            for &h in &movers {
-                for e in [e1, e2] {
+        let (e1, e2) = {
+            let e1 = s.gravity.any_orthonormal_vector();
+            (e1, s.gravity.cross(e1))
+        };
+        let units: Vec<(usize, DVec3)> = if superpose {
+            movers.iter().flat_map(|&h| [(h, e1), (h, e2)]).collect()
+        } else {
+            Vec::new()
+        };
+        let rhs: Vec<Vec<Vec6>> = if superpose {
+            units
+                .iter()
+                .map(|&(h, e)| {
                     let mut f_unit = vec![Vec6::zeros(); bodies.len()];
                     f_unit[local[s.hanging[h].pivot] as usize] =
                         Vec6::new(0.0, 0.0, 0.0, e.x, e.y, e.z);
-                    rhs.push(f_unit);
-                    units.push((h, e));
-                }
-            }
+                    f_unit
+                })
+                .collect()
         } else if poses.len() > 1 {
-            for &pose in &poses {
-                rhs.push(
-                    body_loads(s, pose)
-                        .into_iter()
-                        .enumerate()
-                        .filter(|(b, _)| local[*b] != u32::MAX)
-                        .map(|(_, f)| f)
-                        .collect(),
-                );
-            }
-        }
-        if !rhs.is_empty()
-            && !exact
-            && let Some(factor) = Factor::new(&k)
-        {
-            {
-                out.factorizations += 1;
-                let index = bodies
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &b)| (key(&s.bodies[b]), i as u32))
-                    .collect();
-                reference = Some(Reference { factor, index });
-                exact = true;
-            }
-        }
-        if exact && let Some(r) = reference.as_ref() {
-            r.factor.solve_many_in_place(&mut rhs);
+            poses
+                .iter()
+                .map(|&pose| local_loads(s, pose, &local))
+                .collect()
         } else {
-            // No factor (a mechanism, e.g. a sliding contact): one by one.
-            for f_k in &mut rhs {
-                let mut q_k = screen.q_reference.clone();
-                converged &= self.solve(s, bodies, &k, f_k, &mut q_k, &mut reference, out);
-                f_k.copy_from_slice(&q_k);
-            }
-            if !converged {
-                screen.links = vec![LinkResult::default(); links.len()];
-                screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
-                return (screen, reference);
-            }
-        }
-        // Interface forces of each solution.
+            Vec::new()
+        };
+        let Some(solutions) = self.solve_many(s, bodies, &mut st, rhs, &mut reference, out) else {
+            no_witness(&mut screen, poses);
+            return (screen, reference);
+        };
         let basis: Vec<(usize, DVec3, Vec<Vec6>)> = if superpose {
             units
                 .into_iter()
-                .zip(rhs.iter().map(|q_k| sf_of(q_k)))
+                .zip(solutions.iter().map(|q_k| sf_of(q_k)))
                 .map(|((h, e), sf)| (h, e, sf))
                 .collect()
         } else {
             Vec::new()
         };
-        // A mover's moment on its pivot at a pose, less its reference one.
-        let moment_change = |h: usize, pose: Option<usize>| -> DVec3 {
-            let hg = &s.hanging[h];
-            let p = s.bodies[hg.pivot].centre;
-            let at = |r: DVec3| r.cross(g);
-            let reference = at(worst_lever(hg.path.iter().map(|c| *c - p), g));
-            match pose {
-                Some(k) => at(hg.path[k.min(hg.path.len() - 1)] - p) - reference,
-                None => DVec3::ZERO,
-            }
-        };
-        screen.links = vec![LinkResult::default(); links.len()];
         let mut slot = vec![usize::MAX; s.links.len()];
         for (j, &li) in active.iter().enumerate() {
             slot[li] = j;
         }
         // Each pose's interface forces, one at a time (never all stored).
+        screen.links = vec![LinkResult::default(); links.len()];
         let mut sf: Vec<Vec6> = Vec::new();
-        let mut first = true;
-        for pose in poses {
+        for (i, pose) in poses.into_iter().enumerate() {
             match pose {
                 None => sf.clone_from(&sf_reference),
                 Some(_) if superpose => {
                     sf.clone_from(&sf_reference);
                     for (h, e, sf_b) in &basis {
-                        let c = moment_change(*h, pose).dot(*e);
+                        let c = moment_change(s, *h, pose).dot(*e);
                         if c != 0.0 {
                             sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                         }
                     }
                 }
-                Some(p) => sf = sf_of(&rhs[p]),
+                Some(p) => sf = sf_of(&solutions[p]),
             }
-            let mut worst: f64 = 0.0;
-            let mut gate: f64 = 0.0;
-            // The smallest down-scaling of the elastic forces the corners
-            // carry everywhere: an upper bound of 1/λ (branch and bound).
-            let mut scale: f64 = 0.0;
-            for (j, &li) in links.iter().enumerate() {
-                if released[li] {
-                    if first {
-                        screen.links[j] = LinkResult {
-                            released: true,
-                            ..Default::default()
-                        };
-                    }
-                    continue;
-                }
-                let l = &s.links[li];
-                let (load, _, _) = self.load_of(l, &sf[slot[li]]);
-                let cap = self.capacity(l);
-                let u = severity(utilisation(&load, cap).0);
-                worst = worst.max(u);
-                // A witness must also be carried by the limit analysis's
-                // corner forces (torsion on a square pressed off-centre).
-                let r = severity(corner_ratio(&load, cap));
-                if self.settings.corner_gate && overloaded(r) {
-                    gate = gate.max(r);
-                    // The elastic forces scaled down by `k` keep the centre
-                    // of pressure no further out and the clamp at
-                    // `pL² − N/k`: the corners carry them from
-                    // `k = r − (r − 1)·N/pL²` (none for a contact without
-                    // adhesion, where scaling changes no ratio).
-                    let p = cap.tension();
-                    scale = scale.max(if p > 0.0 {
-                        r - (r - 1.0) * load.axial / p
-                    } else {
-                        f64::INFINITY
-                    });
-                }
-                if first || u > severity(screen.links[j].utilisation) {
-                    screen.links[j] = self.link_result(l, &sf[slot[li]], sliding[li]);
-                }
-            }
-            first = false;
-            if overloaded(worst) || overloaded(gate) {
+            let sf_link = |li: usize| &sf[slot[li]];
+            let judged = self.judge_pose(s, links, &st, &sf_link, i == 0, &mut screen.links);
+            if overloaded(judged.worst) || overloaded(judged.gate) {
                 // Branch and bound needs an upper bound of 1/λ: the
                 // utilisation where the corners carry the forces, else the
                 // scaling at which they do.
-                screen.failing.push((pose, worst.max(severity(scale))));
+                screen
+                    .failing
+                    .push((pose, judged.worst.max(severity(judged.scale))));
             } else {
-                screen.admissible = screen.admissible.max(worst);
+                screen.admissible = screen.admissible.max(judged.worst);
             }
         }
         screen.failing.sort_by(|a, b| b.1.total_cmp(&a.1));
         (screen, reference)
+    }
+
+    /// The elastic equilibrium of component `c` at the reference pose, its
+    /// ground contacts made unilateral by an active set: contacts pulled
+    /// apart let go; failing that, those beyond their friction slide.
+    fn settle(
+        &mut self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        local: &[u32],
+        reference: &mut Option<Reference>,
+        out: &mut Analysis,
+    ) -> Settled {
+        let bodies = &comps.bodies[c];
+        let links = &comps.links[c];
+        let f = local_loads(s, None, local);
+        let mut st = Settled {
+            k: BlockMatrix::new(0),
+            q: bodies
+                .iter()
+                .map(|&b| {
+                    self.warm
+                        .get(&key(&s.bodies[b]))
+                        .copied()
+                        .unwrap_or_else(Vec6::zeros)
+                })
+                .collect(),
+            released: vec![false; s.links.len()],
+            sliding: vec![false; s.links.len()],
+            anchored: false,
+            converged: true,
+            exact: false,
+        };
+        let mut q_all = vec![Vec6::zeros(); s.bodies.len()];
+        for _round in 0..=self.settings.max_release_rounds {
+            // The component stands only while some link ties it to the
+            // ground or to a fixed module.
+            st.anchored = links.iter().any(|&li| {
+                !st.released[li]
+                    && (comps.of(s, End::Body(s.links[li].a)).is_none()
+                        || comps.of(s, s.links[li].b).is_none())
+            });
+            if !st.anchored {
+                break;
+            }
+            st.k = self.assemble(s, links, local, &st.released, &st.sliding, bodies.len());
+            let before = out.factorizations;
+            st.converged = self.solve(s, bodies, &st.k, &f, &mut st.q, reference, out);
+            st.exact = out.factorizations > before;
+            for (i, &b) in bodies.iter().enumerate() {
+                q_all[b] = st.q[i];
+            }
+            let mut lift = Vec::new();
+            let mut slide = Vec::new();
+            for &li in links {
+                let l = &s.links[li];
+                if !l.is_ground() || st.released[li] {
+                    continue;
+                }
+                let sf = self.link_sf(s, l, &q_all, st.sliding[li]);
+                let load = self.load_of(l, &sf).0;
+                let (u, mode) = utilisation(&load, &self.model.ground);
+                if overloaded(u) {
+                    match mode {
+                        // Only a contact pulled apart lets go; one pressed
+                        // but tipped past its edge stays (it still bears),
+                        // and if no witness results the limit analysis
+                        // decides.
+                        Mode::Bending if load.axial > 0.0 => lift.push(li),
+                        Mode::Bending => {}
+                        Mode::Friction if !st.sliding[li] => slide.push(li),
+                        Mode::Friction => {}
+                    }
+                }
+            }
+            if !lift.is_empty() {
+                lift.into_iter().for_each(|li| st.released[li] = true);
+            } else if !slide.is_empty() {
+                slide.into_iter().for_each(|li| st.sliding[li] = true);
+            } else {
+                break;
+            }
+        }
+        st
+    }
+
+    /// Solves the settled matrix for several right-hand sides at once, by
+    /// the factor of this step's matrix (made now if the step reused an
+    /// older one), or one by one by CG where no factor exists (a
+    /// mechanism). `None` if some solve did not converge.
+    fn solve_many(
+        &mut self,
+        s: &Structure,
+        bodies: &[usize],
+        st: &mut Settled,
+        mut rhs: Vec<Vec<Vec6>>,
+        reference: &mut Option<Reference>,
+        out: &mut Analysis,
+    ) -> Option<Vec<Vec<Vec6>>> {
+        if rhs.is_empty() {
+            return Some(rhs);
+        }
+        if !st.exact
+            && let Some(factor) = Factor::new(&st.k)
+        {
+            out.factorizations += 1;
+            let index = bodies
+                .iter()
+                .enumerate()
+                .map(|(i, &b)| (key(&s.bodies[b]), i as u32))
+                .collect();
+            *reference = Some(Reference { factor, index });
+            st.exact = true;
+        }
+        if st.exact
+            && let Some(r) = reference.as_ref()
+        {
+            r.factor.solve_many_in_place(&mut rhs);
+            return Some(rhs);
+        }
+        for f_k in &mut rhs {
+            let mut q_k = st.q.clone();
+            if !self.solve(s, bodies, &st.k, f_k, &mut q_k, reference, out) {
+                return None;
+            }
+            f_k.copy_from_slice(&q_k);
+        }
+        Some(rhs)
+    }
+
+    /// Judges one pose from its interface forces: each link's utilisation
+    /// (kept in `links` where it is the link's worst so far), and whether
+    /// the limit analysis's corners carry the field.
+    fn judge_pose<'f>(
+        &self,
+        s: &Structure,
+        links: &[usize],
+        st: &Settled,
+        sf: &dyn Fn(usize) -> &'f Vec6,
+        first: bool,
+        results: &mut [LinkResult],
+    ) -> Judged {
+        let mut j_out = Judged::default();
+        for (j, &li) in links.iter().enumerate() {
+            if st.released[li] {
+                if first {
+                    results[j] = LinkResult {
+                        released: true,
+                        ..Default::default()
+                    };
+                }
+                continue;
+            }
+            let l = &s.links[li];
+            let (load, _, _) = self.load_of(l, sf(li));
+            let cap = self.capacity(l);
+            let u = severity(utilisation(&load, cap).0);
+            j_out.worst = j_out.worst.max(u);
+            // A witness must also be carried by the limit analysis's
+            // corner forces (torsion on a square pressed off-centre).
+            let r = severity(corner_ratio(&load, cap));
+            if self.settings.corner_gate && overloaded(r) {
+                j_out.gate = j_out.gate.max(r);
+                // The elastic forces scaled down by `k` keep the centre of
+                // pressure no further out and the clamp at `pL² − N/k`:
+                // the corners carry them from `k = r − (r − 1)·N/pL²`
+                // (never for a contact without adhesion, where scaling
+                // changes no ratio).
+                let p = cap.tension();
+                j_out.scale = j_out.scale.max(if p > 0.0 {
+                    r - (r - 1.0) * load.axial / p
+                } else {
+                    f64::INFINITY
+                });
+            }
+            if first || u > severity(results[j].utilisation) {
+                results[j] = self.link_result(l, sf(li), st.sliding[li]);
+            }
+        }
+        j_out
     }
 
     /// One link's result from its interface force `sf` (units `W`, `W·d`).

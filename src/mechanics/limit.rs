@@ -130,56 +130,110 @@ pub fn load_factor(
             iterations: 0,
         };
     }
-    // Columns: per link, per corner of its contact square, the normal
-    // force n (tension > 0), the tangential force (t_u, t_v) and its bound
-    // z ≥ ‖t‖; then λ.
-    const PER_CORNER: usize = 4;
-    const PER_LINK: usize = 4 * PER_CORNER;
-    let nl = links.len();
-    let lam = PER_LINK * nl;
-    let ncol = lam + 1;
-    let (mut ri, mut ci, mut vals) = (Vec::new(), Vec::new(), Vec::new());
-    let mut push = |r: usize, c: usize, v: f64| {
+    let mut prog = Program::new(6 * n_groups, PER_LINK * links.len());
+    let frame = Frame {
+        row_of: &row_of,
+        origin: &origin,
+    };
+    equilibrium_rows(&mut prog, s, model, loads, part, &links, &frame);
+    capacity_rows(&mut prog, s, model, &links);
+    maximise(prog)
+}
+
+/// Columns per corner of a contact square: the normal force `n` (tension
+/// > 0), the tangential force `(t_u, t_v)` and its bound `z ≥ ‖t‖`.
+const PER_CORNER: usize = 4;
+const PER_LINK: usize = 4 * PER_CORNER;
+const CORNERS: [(f64, f64); 4] = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+
+/// The conic program being assembled: `A x + s = b`, `s` in the zero cone
+/// (equilibrium rows), the non-negative cone (capacity rows) and one
+/// second-order cone per corner; the last column is `λ`.
+struct Program {
+    triplets: (Vec<usize>, Vec<usize>, Vec<f64>),
+    rhs: Vec<f64>,
+    n_eq: usize,
+    /// `(z, t_u, t_v)` columns of each corner's friction cone.
+    socs: Vec<(usize, usize, usize)>,
+    lam: usize,
+}
+
+impl Program {
+    fn new(n_eq: usize, n_forces: usize) -> Program {
+        Program {
+            triplets: Default::default(),
+            rhs: vec![0.0; n_eq],
+            n_eq,
+            socs: Vec::new(),
+            lam: n_forces,
+        }
+    }
+
+    fn push(&mut self, r: usize, c: usize, v: f64) {
         if v != 0.0 {
-            ri.push(r);
-            ci.push(c);
-            vals.push(v);
+            self.triplets.0.push(r);
+            self.triplets.1.push(c);
+            self.triplets.2.push(v);
         }
-    };
-    let corners = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
-    let capacity = |li: usize| -> &Capacity {
-        if s.links[li].is_ground() {
-            &model.ground
-        } else {
-            &model.connector
+    }
+
+    /// Appends a row `Σ coef·x ≤ b` (or `= −s` for cone rows).
+    fn row(&mut self, terms: &[(usize, f64)], b: f64) {
+        let r = self.rhs.len();
+        for &(c, v) in terms {
+            self.push(r, c, v);
         }
-    };
-    // Equilibrium rows: Σ (corner forces on the group) + λ·load = 0.
-    let n_eq = 6 * n_groups;
+        self.rhs.push(b);
+    }
+}
+
+/// Where each free body's equations are, and the point its moments are
+/// taken about.
+struct Frame<'a> {
+    row_of: &'a [usize],
+    origin: &'a dyn Fn(usize) -> glam::DVec3,
+}
+
+fn capacity<'m>(s: &Structure, model: &'m Model, li: usize) -> &'m Capacity {
+    if s.links[li].is_ground() {
+        &model.ground
+    } else {
+        &model.connector
+    }
+}
+
+/// Equilibrium rows: Σ (corner forces on the group) + λ·load = 0.
+fn equilibrium_rows(
+    prog: &mut Program,
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    links: &[usize],
+    frame: &Frame<'_>,
+) {
+    let is_free = |i: usize| frame.row_of[i] != usize::MAX;
     for (k, &li) in links.iter().enumerate() {
         let l = &s.links[li];
-        let half = 0.5 * capacity(li).side / model.spacing;
-        for (ki, (su, sv)) in corners.iter().enumerate() {
+        let half = 0.5 * capacity(s, model, li).side / model.spacing;
+        for (ki, (su, sv)) in CORNERS.iter().enumerate() {
             let corner = l.contact + half * (su * l.u + sv * l.v);
             let col = PER_LINK * k + PER_CORNER * ki;
             // Unit forces on side b: a tension n pulls b towards a.
             let dirs = [-l.normal, l.u, l.v];
-            let mut side = |body: usize, sign: f64| {
-                if !is_free(body) {
-                    return;
-                }
-                let r0 = row_of[body];
-                let arm = corner - origin(body);
+            let ends = [(Some(l.a), -1.0), (l.b.body(), 1.0)];
+            for (body, sign) in ends {
+                let Some(body) = body.filter(|&b| is_free(b)) else {
+                    continue;
+                };
+                let r0 = frame.row_of[body];
+                let arm = corner - (frame.origin)(body);
                 for (j, f) in dirs.iter().enumerate() {
                     let m = arm.cross(*f);
                     for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
-                        push(r0 + a, col + j, sign * v);
+                        prog.push(r0 + a, col + j, sign * v);
                     }
                 }
-            };
-            side(l.a, -1.0);
-            if let End::Body(b) = l.b {
-                side(b, 1.0);
             }
         }
     }
@@ -187,19 +241,19 @@ pub fn load_factor(
         if is_free(i) {
             let f = glam::DVec3::new(loads[i][0], loads[i][1], loads[i][2]);
             let m = glam::DVec3::new(loads[i][3], loads[i][4], loads[i][5])
-                + (s.bodies[i].centre - origin(i)).cross(f);
+                + (s.bodies[i].centre - (frame.origin)(i)).cross(f);
             for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
-                push(row_of[i] + a, lam, v);
+                prog.push(frame.row_of[i] + a, prog.lam, v);
             }
         }
     }
-    // Capacity rows (A x ≤ b).
+}
+
+/// Capacity rows (`A x ≤ b`) and friction cones of every link's corners.
+fn capacity_rows(prog: &mut Program, s: &Structure, model: &Model, links: &[usize]) {
     let w = model.weight();
-    let mut rhs = vec![0.0; n_eq];
-    let mut row = n_eq;
-    let mut socs = Vec::new();
     for (k, &li) in links.iter().enumerate() {
-        let cap = capacity(li);
+        let cap = capacity(s, model, li);
         // The adhesion a corner holds: a quarter of the square's.
         let p = cap.tension() / w / 4.0;
         let col = |ki: usize| PER_LINK * k + PER_CORNER * ki;
@@ -209,24 +263,21 @@ pub fn load_factor(
                 // resultant anywhere in the square (a rigid, fully plastic
                 // interface).
                 for ki in 0..4 {
-                    push(row, col(ki), 1.0);
-                    rhs.push(p);
-                    row += 1;
+                    prog.row(&[(col(ki), 1.0)], p);
                 }
             }
             Bending::Elastic => {
-                // A linear stress distribution over the square within the
-                // pressure: N + 6(±M_u ± M_v)/L ≤ pL², with the corner
-                // forces' resultants (corner (s_u, s_v) contributes
-                // n·(1 ± s_u·3 ± s_v·3)/… — written out per corner).
-                for (eu, ev) in corners {
-                    for (ki, (su, sv)) in corners.iter().enumerate() {
-                        // Moment of a unit tension at this corner about
-                        // the square's axes, in units of L/2: ±1.
-                        push(row, col(ki), 1.0 + 3.0 * (eu * su + ev * sv));
-                    }
-                    rhs.push(4.0 * p);
-                    row += 1;
+                // A linear stress distribution within the pressure:
+                // N + 6(±M_u ± M_v)/L ≤ pL² on the corner forces'
+                // resultants (a unit tension at corner (s_u, s_v) has
+                // moments ±L/2 about the square's axes).
+                for (eu, ev) in CORNERS {
+                    let terms: Vec<(usize, f64)> = CORNERS
+                        .iter()
+                        .enumerate()
+                        .map(|(ki, (su, sv))| (col(ki), 1.0 + 3.0 * (eu * su + ev * sv)))
+                        .collect();
+                    prog.row(&terms, 4.0 * p);
                 }
             }
         }
@@ -234,39 +285,39 @@ pub fn load_factor(
         // corner's share of adhesion.
         for ki in 0..4 {
             let (n, z) = (col(ki), col(ki) + 3);
-            push(row, n, cap.friction);
-            push(row, z, 1.0);
-            rhs.push(cap.friction * p);
-            row += 1;
-            socs.push((z, col(ki) + 1, col(ki) + 2));
+            prog.row(&[(n, cap.friction), (z, 1.0)], cap.friction * p);
+            prog.socs.push((z, col(ki) + 1, col(ki) + 2));
         }
     }
-    // λ ≤ cap.
-    push(row, lam, 1.0);
-    rhs.push(LAMBDA_CAP);
-    row += 1;
-    let n_nonneg = row - n_eq;
-    // Second-order cones: s = (z, Vu, Vv) = −A x.
-    for &(z, vu, vv) in &socs {
-        for c in [z, vu, vv] {
-            push(row, c, -1.0);
-            rhs.push(0.0);
-            row += 1;
+}
+
+/// Maximises `λ ≤ LAMBDA_CAP` (clarabel). Interior point on these
+/// degenerate problems (free tangential forces circulating between
+/// corners) can stall on round-off: it retries with stronger
+/// regularisation of the KKT system before giving up (NaN).
+fn maximise(mut prog: Program) -> LimitResult {
+    let lam = prog.lam;
+    let ncol = lam + 1;
+    prog.row(&[(lam, 1.0)], LAMBDA_CAP);
+    let n_nonneg = prog.rhs.len() - prog.n_eq;
+    // Second-order cones: s = (z, t_u, t_v) = −A x.
+    for (z, tu, tv) in std::mem::take(&mut prog.socs).iter().copied() {
+        for c in [z, tu, tv] {
+            prog.row(&[(c, -1.0)], 0.0);
         }
+        prog.socs.push((z, tu, tv));
     }
-    let a = CscMatrix::new_from_triplets(row, ncol, ri, ci, vals);
+    let (ri, ci, vals) = std::mem::take(&mut prog.triplets);
+    let a = CscMatrix::new_from_triplets(prog.rhs.len(), ncol, ri, ci, vals);
     let p = CscMatrix::<f64>::zeros((ncol, ncol));
     let mut q = vec![0.0; ncol];
     q[lam] = -1.0;
     let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
-    if n_eq > 0 {
-        cones.push(ZeroConeT(n_eq));
+    if prog.n_eq > 0 {
+        cones.push(ZeroConeT(prog.n_eq));
     }
     cones.push(NonnegativeConeT(n_nonneg));
-    cones.extend(socs.iter().map(|_| SecondOrderConeT(3)));
-    // Interior point on these degenerate problems (free tangential forces
-    // circulating between corners) can stall on round-off: retry with
-    // stronger regularisation of the KKT system before giving up.
+    cones.extend(prog.socs.iter().map(|_| SecondOrderConeT(3)));
     let mut lambda = f64::NAN;
     let mut iterations = 0;
     for (regularisation, tolerance) in [(1e-8, 1e-8), (1e-6, 1e-7), (1e-5, 1e-6)] {
@@ -279,7 +330,7 @@ pub fn load_factor(
             .static_regularization_constant(regularisation)
             .build()
             .expect("valid settings");
-        let Ok(mut solver) = DefaultSolver::new(&p, &q, &a, &rhs, &cones, settings) else {
+        let Ok(mut solver) = DefaultSolver::new(&p, &q, &a, &prog.rhs, &cones, settings) else {
             break;
         };
         solver.solve();

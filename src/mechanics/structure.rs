@@ -27,6 +27,16 @@ pub enum End {
     Ground(Cell),
 }
 
+impl End {
+    /// The body at this end, if it is one (not the ground).
+    pub fn body(self) -> Option<usize> {
+        match self {
+            End::Body(b) => Some(b),
+            End::Ground(_) => None,
+        }
+    }
+}
+
 /// A connector square between two latched modules, or a module's contact
 /// with the ground.
 #[derive(Clone, Debug, PartialEq)]
