@@ -46,6 +46,10 @@ pub enum ImportCommand {
         /// Lattice spacing d in millimetres (the 3D Catom: 3.6 mm).
         #[arg(long, default_value_t = 3.6, value_name = "MM")]
         spacing_mm: f64,
+        /// Write the configuration's CSG target instead of its blocks: one
+        /// module in every grid cell VisibleSim counts as inside the target.
+        #[arg(long)]
+        target: bool,
         #[command(flatten)]
         ground: GroundArgs,
     },
@@ -128,17 +132,51 @@ pub fn import(cmd: ImportCommand) -> Result<u8, Error> {
             output,
             lattice,
             spacing_mm,
+            target,
             ground,
         } => {
             let d = spacing(spacing_mm)?;
-            let cfg = read_config(&config, lattice)?;
-            let s = interop::import_config(
+            let mut cfg = read_config(&config, lattice)?;
+            let cells = interop::target_cells(&cfg, lattice).map_err(|e| e.in_file(&config))?;
+            if let Some(c) = &cells {
+                eprintln!(
+                    "{}: CSG target of {} cells ({} grid)",
+                    config.display(),
+                    c.len(),
+                    lattice.name()
+                );
+            }
+            if target {
+                let Some(c) = cells else {
+                    return Err(
+                        InputError::new("--target: the configuration has no <csg> target")
+                            .in_file(&config)
+                            .into(),
+                    );
+                };
+                cfg.blocks = c
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &cell)| interop::VsBlock {
+                        id: k as u32 + 1,
+                        position: lattice.to_grid(cell),
+                        color: None,
+                        orientation: None,
+                        master: false,
+                        line: 0,
+                    })
+                    .collect();
+            }
+            let mut s = interop::import_config(
                 &cfg,
                 lattice,
                 ground.choice(),
                 d,
                 &config.display().to_string(),
             );
+            if target {
+                s.meta.insert("visiblesim_target".into(), true.into());
+            }
             write_schedule(&s, &output)?;
             eprintln!(
                 "{}: {} modules ({} grid) -> {}",

@@ -9,9 +9,11 @@
 
 mod trace;
 mod visiblesim;
+mod vs_csg;
 
 pub use trace::{TraceOptions, TraceRow, read_trace, trace_to_schedule};
 pub use visiblesim::{
     GroundChoice, VsBlock, VsConfig, VsLattice, config_at_step, export_config, import_config,
     read_config,
 };
+pub use vs_csg::{MAX_VS_DEPTH, VsNode, parse_vs_csg, target_cells};

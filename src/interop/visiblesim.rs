@@ -65,7 +65,7 @@ impl VsLattice {
     /// VisibleSim's `gridToUnscaledWorldPosition`: its world frame puts a
     /// cell's centre at our centre plus (½, ½, √2/4) (the corner of the
     /// grid is at the origin).
-    fn unscaled_world(self, p: [i32; 3]) -> DVec3 {
+    pub(crate) fn unscaled_world(self, p: [i32; 3]) -> DVec3 {
         let z = (p[2] as f64 + 0.5) * std::f64::consts::FRAC_1_SQRT_2;
         match self {
             VsLattice::Fcc => {
