@@ -268,6 +268,9 @@ impl Parser {
             }
             "translate" | "scale" => {
                 let v = three(self, &nums)?;
+                // VisibleSim skips ';' like a space: `scale([2,2,2]); sphere(10);`
+                // scales the sphere.
+                while self.eat(';') {}
                 if self.peek() == Some(&Tok::Sym('{')) {
                     return Err(self.err(format!(
                         "VisibleSim applies {name} to the next object only and reads this block's \
@@ -555,6 +558,12 @@ mod tests {
         // float32: 0.1 is stored as 0.100000001490116…
         let f = parse_vs_csg("sphere(0.1);", 1).unwrap();
         assert_eq!(f, VsNode::Sphere(0.1f32 as f64));
+        // A ';' after a transform is skipped, as VisibleSim skips it.
+        let s = parse_vs_csg("scale([2,2,2]); sphere(10, true);", 1).unwrap();
+        assert_eq!(
+            s,
+            VsNode::Scale(DVec3::splat(2.0), Box::new(VsNode::Sphere(10.0)))
+        );
     }
 
     #[test]
