@@ -5,7 +5,7 @@ use clap::{Args, Subcommand};
 use reconfcheck::error::{Error, InputError, read_file, write_file};
 use reconfcheck::interop::{self, GroundChoice, VsLattice};
 use reconfcheck::schedule::{Length, Schedule};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// How the imported structure meets the ground.
 #[derive(Args, Clone, Debug)]
@@ -115,12 +115,12 @@ fn spacing(mm: f64) -> Result<Length, Error> {
     Ok(Length::mm(mm))
 }
 
-fn read_config(path: &PathBuf, lattice: VsLattice) -> Result<interop::VsConfig, Error> {
+fn read_config(path: &Path, lattice: VsLattice) -> Result<interop::VsConfig, Error> {
     let text = read_file(path, "VisibleSim configuration")?;
     Ok(interop::read_config(&text, path, lattice)?)
 }
 
-fn write_schedule(s: &Schedule, path: &PathBuf) -> Result<(), Error> {
+fn write_schedule(s: &Schedule, path: &Path) -> Result<(), Error> {
     s.validate().map_err(|e| e.in_file(path))?;
     write_file(path, s.to_json())
 }

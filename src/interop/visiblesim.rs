@@ -143,7 +143,7 @@ pub struct VsConfig {
     pub target_list: Option<String>,
     /// The attributes of the first `<csg>` target (`content`, `translate`,
     /// `boundingBox`, …), verbatim, and its line.
-    pub csg: Option<(BTreeMap<String, String>, u32)>,
+    pub csg: Option<CsgAttrs>,
 }
 
 /// An input error at an XML node: line, column and element named.
@@ -306,10 +306,10 @@ fn text_of(doc: &Document, node: Node) -> String {
     doc.input_text()[node.range()].to_string()
 }
 
-fn find_csg(
-    doc: &Document,
-    list: Node,
-) -> Result<Option<(BTreeMap<String, String>, u32)>, InputError> {
+/// A `<csg>` element's attributes and its line.
+type CsgAttrs = (BTreeMap<String, String>, u32);
+
+fn find_csg(doc: &Document, list: Node) -> Result<Option<CsgAttrs>, InputError> {
     for target in list.children().filter(|n| n.is_element()) {
         if target.tag_name().name() != "target" {
             return Err(at(doc, target, "expected <target> in <targetList>"));
