@@ -62,6 +62,18 @@ impl VsLattice {
         }
     }
 
+    /// Whether grid position `p` lies in VisibleSim's grid of size `g`
+    /// (`isInGrid`): `0 ≤ p < g` on the FCC lattice; on the skewed one
+    /// layer z spans x, y in `[−⌊z/2⌋, g − ⌊z/2⌋)` (`SkewFCCLattice::
+    /// getGridLowerBounds`), the same straight box in our frame.
+    pub fn in_grid(self, p: [i32; 3], g: [i32; 3]) -> bool {
+        let h = match self {
+            VsLattice::Fcc => 0,
+            VsLattice::SkewedFcc => p[2].max(0) / 2,
+        };
+        (0..2).all(|k| p[k] >= -h && p[k] < g[k] - h) && p[2] >= 0 && p[2] < g[2]
+    }
+
     /// VisibleSim's `gridToUnscaledWorldPosition`: its world frame puts a
     /// cell's centre at our centre plus (½, ½, √2/4) (the corner of the
     /// grid is at the origin).
@@ -384,7 +396,7 @@ fn read_blocks(
     let mut next_id = 0u32;
     let mut push = |cfg: &mut VsConfig, node: Node, b: VsBlock| -> Result<(), InputError> {
         let g = cfg.grid_size;
-        if (0..3).any(|k| b.position[k] < 0 || b.position[k] >= g[k]) {
+        if !lattice.in_grid(b.position, g) {
             return Err(at(
                 doc,
                 node,
@@ -726,17 +738,18 @@ pub fn export_config(s: &Schedule, step: usize, lattice: VsLattice) -> Result<St
     {
         Some(g) => g,
         None => {
+            // Both grids are the same straight box in our frame.
             let mut g = [1; 3];
-            for (_, p) in &positions {
-                for k in 0..3 {
-                    g[k] = g[k].max(p[k] + 1);
+            for c in modules.values() {
+                for (k, v) in [c.x, c.y, c.z].into_iter().enumerate() {
+                    g[k] = g[k].max(v + 1);
                 }
             }
             g
         }
     };
     for (id, p) in &positions {
-        if (0..3).any(|k| p[k] < 0 || p[k] >= grid_size[k]) {
+        if !lattice.in_grid(*p, grid_size) {
             return Err(InputError::new(format!(
                 "position {p:?} in VisibleSim's {} grid lies outside its grid 0..{grid_size:?}",
                 lattice.name()
@@ -842,6 +855,31 @@ mod tests {
         assert_eq!(c.blocks[1].position, [6, 5, 2]);
         let (csg, _) = c.csg.unwrap();
         assert_eq!(csg["translate"], "5,5,2");
+    }
+
+    /// VisibleSim's skewed grid starts layer z at x, y = −⌊z/2⌋: a block
+    /// at (−1, −1, 2) is in it, one at (−1, 0, 1) is not.
+    #[test]
+    fn the_skewed_grid_is_a_straight_box_in_our_frame() {
+        let xml = |p: &str| {
+            format!(
+                "<world gridSize=\"4,4,4\"><blockList><block position=\"{p}\"/></blockList></world>"
+            )
+        };
+        let sk = |p: &str| read_config(&xml(p), Path::new("t.xml"), VsLattice::SkewedFcc);
+        assert!(sk("-1,-1,2").is_ok());
+        assert!(sk("2,2,3").is_ok() && sk("3,0,3").is_err());
+        assert!(sk("-1,0,1").is_err());
+        assert!(read("-1,-1,2").is_err());
+        fn read(p: &str) -> Result<VsConfig, InputError> {
+            read_config(
+                &format!(
+                    "<world gridSize=\"4,4,4\"><blockList><block position=\"{p}\"/></blockList></world>"
+                ),
+                Path::new("t.xml"),
+                VsLattice::Fcc,
+            )
+        }
     }
 
     #[test]

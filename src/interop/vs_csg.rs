@@ -17,7 +17,8 @@
 //!   `W(g) + bb.P0 − translate` (W: VisibleSim's unscaled world position,
 //!   bb.P0 the solid's bounding-box corner when `boundingBox` is true — the
 //!   default — with a further −1 when `offset` is true), for g inside
-//!   `gridSize` only.
+//!   `gridSize` only (on the skewed lattice layer z spans x, y from
+//!   −⌊z/2⌋, as `SkewFCCLattice::getGridLowerBounds` says).
 //!
 //! Not read (refused with line and column): `rotate` (VisibleSim's
 //! rotation matrices are not reproduced here), a one-number `cube(s)`
@@ -526,12 +527,16 @@ pub fn target_cells(cfg: &VsConfig, lattice: VsLattice) -> Result<Option<Vec<Cel
     }
     let g = cfg.grid_size;
     let mut cells = Vec::new();
+    // The grid is the same straight box in our frame for both lattices
+    // (see `VsLattice::in_grid`): scan our cells, ask in VisibleSim's grid.
     for z in 0..g[2] {
         for y in 0..g[1] {
             for x in 0..g[0] {
-                let w = lattice.unscaled_world([x, y, z]) + p0 - translate;
+                let cell = Cell::new(x, y, z);
+                let p = lattice.to_grid(cell);
+                let w = lattice.unscaled_world(p) + p0 - translate;
                 if root.contains(w) {
-                    cells.push(lattice.to_cell([x, y, z]));
+                    cells.push(cell);
                 }
             }
         }
