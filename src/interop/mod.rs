@@ -7,13 +7,14 @@
 //! model) and below the command line; nothing in `algorithms` or
 //! `certify` depends on it.
 
+mod target;
 mod trace;
 mod visiblesim;
-mod vs_csg;
 
+pub use crate::algorithms::scaffold::vs_csg::{MAX_VS_DEPTH, VsNode, parse_vs_csg};
+pub use target::target_cells;
 pub use trace::{TraceOptions, TraceRow, read_trace, trace_to_schedule};
 pub use visiblesim::{
     GroundChoice, VsBlock, VsConfig, VsLattice, config_at_step, export_config, import_config,
     read_config,
 };
-pub use vs_csg::{MAX_VS_DEPTH, VsNode, parse_vs_csg, target_cells};

@@ -24,9 +24,8 @@
 //! rotation matrices are not reproduced here), a one-number `cube(s)`
 //! (VisibleSim reads it as a degenerate cube), and anything else.
 
-use super::visiblesim::{VsConfig, VsLattice};
+use super::shape::{Shape, Skew};
 use crate::error::InputError;
-use crate::lattice::Cell;
 use glam::DVec3;
 
 /// Deepest nesting of groups or expressions read (see the scaffold CSG
@@ -479,69 +478,153 @@ pub fn parse_vs_csg(text: &str, line0: usize) -> Result<VsNode, InputError> {
     }
 }
 
-/// The cells of a configuration's CSG target, as VisibleSim's `TargetCSG`
-/// decides them (in this crate's frame), or `None` without a CSG target.
-pub fn target_cells(cfg: &VsConfig, lattice: VsLattice) -> Result<Option<Vec<Cell>>, InputError> {
-    let Some((attrs, line)) = &cfg.csg else {
-        return Ok(None);
-    };
-    let line = *line as usize;
-    let content = attrs.get("content").ok_or_else(|| {
-        InputError::new(format!("line {line}, element <csg>: no content attribute"))
-    })?;
-    let root = parse_vs_csg(content, line)?;
-    let flag = |k: &str, default: bool| -> Result<bool, InputError> {
-        match attrs.get(k).map(String::as_str) {
+/// A VisibleSim configuration's CSG target as a scaffold goal shape, as
+/// the authors' `scaffolding_csg` application asks it: the scaffold's
+/// skewed cell s is VisibleSim's skewed grid cell `s + (3, 3, 3)` (its
+/// `sbSeedPos`), inside when `TargetCSG::isInTarget` says so.
+#[derive(Clone, Debug)]
+pub struct VsCsgShape {
+    pub name: String,
+    pub root: VsNode,
+    /// bb.P0 (− 1 with `offset`) − translate: added to W(g).
+    pub shift: DVec3,
+    pub grid_size: [i32; 3],
+}
+
+/// The authors' scaffold seed position in VisibleSim's skewed grid.
+pub const SEED: [i32; 3] = [3, 3, 3];
+
+impl VsCsgShape {
+    /// VisibleSim's skewed `gridToUnscaledWorldPosition`.
+    fn world(g: [i32; 3]) -> DVec3 {
+        DVec3::new(
+            g[0] as f64 + 0.5 + g[2] as f64 / 2.0,
+            g[1] as f64 + 0.5 + g[2] as f64 / 2.0,
+            (g[2] as f64 + 0.5) * std::f64::consts::FRAC_1_SQRT_2,
+        )
+    }
+
+    /// Whether VisibleSim's skewed grid cell g is in the target.
+    pub fn contains_grid(&self, g: [i32; 3]) -> bool {
+        let h = g[2].max(0) / 2;
+        let in_grid = g[2] >= 0
+            && g[2] < self.grid_size[2]
+            && (0..2).all(|k| g[k] >= -h && g[k] < self.grid_size[k] - h);
+        in_grid && self.root.contains(Self::world(g) + self.shift)
+    }
+
+    /// Reads the first CSG target of a VisibleSim configuration file.
+    pub fn load(path: &std::path::Path) -> Result<VsCsgShape, InputError> {
+        let text = crate::error::read_file(path, "VisibleSim configuration")?;
+        let doc = roxmltree::Document::parse_with_options(
+            &text,
+            roxmltree::ParsingOptions {
+                allow_dtd: true,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| InputError::new(format!("malformed XML: {e}")).in_file(path))?;
+        let world = doc.root_element();
+        let grid_size = world
+            .attribute("gridSize")
+            .and_then(|s| {
+                let v: Vec<i32> = s
+                    .split(',')
+                    .map(|t| t.trim().parse().ok())
+                    .collect::<Option<_>>()?;
+                <[i32; 3]>::try_from(v).ok()
+            })
+            .filter(|g| g.iter().all(|&v| (1..=1 << 16).contains(&v)))
+            .ok_or_else(|| InputError::new("<world> has no valid gridSize").in_file(path))?;
+        let csg = doc
+            .descendants()
+            .find(|n| {
+                n.has_tag_name("csg")
+                    && n.parent_element().is_some_and(|t| {
+                        t.has_tag_name("target") && t.attribute("format") == Some("csg")
+                    })
+            })
+            .ok_or_else(|| InputError::new("the configuration has no CSG target").in_file(path))?;
+        let line = doc.text_pos_at(csg.range().start).row as usize;
+        let here =
+            |m: String| InputError::new(format!("line {line}, element <csg>: {m}")).in_file(path);
+        let content = csg
+            .attribute("content")
+            .ok_or_else(|| here("no content".into()))?;
+        let root = parse_vs_csg(content, line).map_err(|e| e.in_file(path))?;
+        let flag = |k: &str, default: bool| match csg.attribute(k) {
             None => Ok(default),
             Some("true" | "1") => Ok(true),
             Some("false" | "0") => Ok(false),
-            Some(o) => Err(InputError::new(format!(
-                "line {line}, element <csg>: {k}=\"{o}\" is not true or false"
-            ))),
+            Some(o) => Err(here(format!("{k}=\"{o}\" is not true or false"))),
+        };
+        let translate = match csg.attribute("translate") {
+            None => DVec3::ZERO,
+            Some(s) => {
+                let v: Vec<f64> = s
+                    .split(',')
+                    .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+                    .collect::<Option<_>>()
+                    .filter(|v: &Vec<f64>| v.len() == 3)
+                    .ok_or_else(|| here(format!("translate '{s}' is not three numbers")))?;
+                DVec3::new(v[0], v[1], v[2])
+            }
+        };
+        let mut p0 = if flag("boundingBox", true)? {
+            root.bounding_box().0
+        } else {
+            DVec3::ZERO
+        };
+        if flag("offset", false)? {
+            p0 -= DVec3::ONE;
         }
-    };
-    let translate = match attrs.get("translate") {
-        None => DVec3::ZERO,
-        Some(s) => {
-            let v: Vec<f64> = s
-                .split(',')
-                .map(|t| t.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .ok()
-                .filter(|v: &Vec<f64>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
-                .ok_or_else(|| {
-                    InputError::new(format!(
-                        "line {line}, element <csg>: translate '{s}' is not three numbers"
-                    ))
-                })?;
-            DVec3::new(v[0], v[1], v[2])
-        }
-    };
-    let mut p0 = if flag("boundingBox", true)? {
-        root.bounding_box().0
-    } else {
-        DVec3::ZERO
-    };
-    if flag("offset", false)? {
-        p0 -= DVec3::ONE;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok(VsCsgShape {
+            name,
+            root,
+            shift: p0 - translate,
+            grid_size,
+        })
     }
-    let g = cfg.grid_size;
-    let mut cells = Vec::new();
-    // The grid is the same straight box in our frame for both lattices
-    // (see `VsLattice::in_grid`): scan our cells, ask in VisibleSim's grid.
-    for z in 0..g[2] {
-        for y in 0..g[1] {
-            for x in 0..g[0] {
-                let cell = Cell::new(x, y, z);
-                let p = lattice.to_grid(cell);
-                let w = lattice.unscaled_world(p) + p0 - translate;
-                if root.contains(w) {
-                    cells.push(cell);
+
+    /// Scaffold-frame bounds covering every target cell of the grid
+    /// (one cell of margin), or `None` when the target is empty.
+    pub fn skew_bounds(&self) -> Option<(Skew, Skew)> {
+        let g = self.grid_size;
+        let (mut lo, mut hi): (Option<[i32; 3]>, [i32; 3]) = (None, [i32::MIN; 3]);
+        for z in 0..g[2] {
+            let h = z / 2;
+            for y in -h..g[1] - h {
+                for x in -h..g[0] - h {
+                    if self.contains_grid([x, y, z]) {
+                        let p = [x - SEED[0], y - SEED[1], z - SEED[2]];
+                        let l = lo.get_or_insert(p);
+                        for k in 0..3 {
+                            l[k] = l[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
+                    }
                 }
             }
         }
+        let lo = lo?;
+        Some((
+            Skew::new(lo[0] - 1, lo[1] - 1, lo[2].min(0)),
+            Skew::new(hi[0] + 1, hi[1] + 1, hi[2] + 1),
+        ))
     }
-    Ok(Some(cells))
+}
+
+impl Shape for VsCsgShape {
+    fn contains(&self, c: Skew) -> bool {
+        self.contains_grid([c.x + SEED[0], c.y + SEED[1], c.z + SEED[2]])
+    }
+    fn describe(&self) -> String {
+        format!("VisibleSim CSG target '{}'", self.name)
+    }
 }
 
 #[cfg(test)]
