@@ -254,3 +254,34 @@ fn every_bundled_csg_shape_still_parses() {
         }
     }
 }
+
+/// A scaffold goal named as a VisibleSim configuration, read as the
+/// authors' scaffolding_csg application reads it: a file of the same form
+/// as their `config_cube_b_6.xml` gives exactly their 5,007 modules (the
+/// sandbox's fixed modules aside).
+#[test]
+fn a_visiblesim_cube_target_gives_the_authors_5007_scaffold_modules() {
+    use reconfcheck::algorithms::scaffold::paper::Protocol;
+    use reconfcheck::algorithms::scaffold::{ShapeSpec, scaffold_schedule_with};
+    use reconfcheck::schedule::Event;
+    let p = tmp("cube_b_6.xml");
+    std::fs::write(
+        &p,
+        "<?xml version=\"1.0\" standalone=\"no\" ?>\n<world gridSize=\"40,40,40\">\n\
+         <blockList color=\"128,128,128\" blocksize=\"10,10,10\">\n\
+         <block position=\"5,5,2\" color=\"0,255,255\" orientation=\"11\" />\n</blockList>\n\
+         <targetList><target format=\"csg\">\n\
+         <csg translate=\"5,5,2\" content=\"cube([30, 30, 22], true);\" />\n\
+         </target></targetList></world>\n",
+    )
+    .unwrap();
+    let s = scaffold_schedule_with(&ShapeSpec::Csg { path: p }, 6, Protocol::Paper).unwrap();
+    let fixed = s.modules.iter().filter(|m| m.fixed).count();
+    let entered = s
+        .steps
+        .iter()
+        .flat_map(|st| &st.events)
+        .filter(|e| matches!(e, Event::Enter { .. }))
+        .count();
+    assert_eq!(s.modules.len() - fixed + entered, 5007);
+}
