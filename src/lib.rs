@@ -15,6 +15,9 @@
 //!    `geometry`'s motion rules and never see `mechanics` or `certify`;
 //! 6. [`certify`] — replays a schedule and runs every check on every step;
 //!    it never sees the generators;
+//! 6. [`interop`] — VisibleSim configurations and webots-visiblesim motion
+//!    traces in and out, converted at this edge (may read the scaffold's
+//!    CSG model; nothing below depends on it);
 //! 7. [`study`] — questions asked over many schedules (the b-study, the
 //!    density study, load maps, synthetic benchmarks);
 //! 8. [`render`] (feature `render`, on by default) — pictures and plots of
@@ -30,6 +33,7 @@ pub mod algorithms;
 pub mod certify;
 pub mod error;
 pub mod geometry;
+pub mod interop;
 pub mod lattice;
 pub mod mechanics;
 pub mod number;

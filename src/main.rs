@@ -60,6 +60,13 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
     },
+    /// Read VisibleSim files as schedules: a configuration (config.xml) or
+    /// a webots-visiblesim motion trace (CSV).
+    #[command(subcommand)]
+    Import(cli::interop::ImportCommand),
+    /// Write a schedule's configuration at a step in another tool's format.
+    #[command(subcommand)]
+    Export(cli::interop::ExportCommand),
     /// Draw the catom geometry: the body, one sweep or one collision
     /// (PNG, or SVG if the file name ends in .svg).
     #[cfg(feature = "render")]
@@ -102,6 +109,8 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
             }
             Ok(0)
         }
+        Command::Import(a) => cli::interop::import(a),
+        Command::Export(a) => cli::interop::export(a),
         #[cfg(feature = "render")]
         Command::Render(a) => cli::pictures::render(a),
     }

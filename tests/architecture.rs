@@ -18,6 +18,7 @@ const RANKS: &[(&str, u32)] = &[
     ("mechanics", 4),
     ("algorithms", 5),
     ("certify", 6),
+    ("interop", 6),
     ("study", 7),
     ("render", 8),
 ];

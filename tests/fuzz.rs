@@ -387,3 +387,85 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// VisibleSim configurations (issue #15): an edited bundled
+    /// `rolls.xml` is refused naming the file, or imports, exports and
+    /// re-imports to the same schedule; its CSG target is read or refused.
+    #[test]
+    fn edited_visiblesim_configurations_are_refused_or_imported_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+        skewed in any::<bool>(),
+    ) {
+        use reconfcheck::interop::{GroundChoice, VsLattice, export_config, import_config, read_config, target_cells};
+        use reconfcheck::schedule::Length;
+        let edited = edited_model("scenarios/visiblesim/rolls.xml", &edits);
+        let lattice = if skewed { VsLattice::SkewedFcc } else { VsLattice::Fcc };
+        let outcome = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
+            let file = Path::new("edited.xml");
+            let cfg = match read_config(&edited, file, lattice) {
+                Ok(c) => c,
+                Err(e) if e.to_string().starts_with("edited.xml: ") => return Ok(()),
+                Err(e) => return Err(format!("names no file: {e}")),
+            };
+            let _ = target_cells(&cfg, lattice);
+            let s = import_config(&cfg, lattice, GroundChoice::Lowest, Length::mm(3.6), "e");
+            let xml = export_config(&s, 0, lattice).map_err(|e| e.to_string())?;
+            let back = read_config(&xml, file, lattice).map_err(|e| format!("{e}\n{xml}"))?;
+            let s2 = import_config(&back, lattice, GroundChoice::Lowest, Length::mm(3.6), "e");
+            if s2 != s {
+                return Err(format!("round trip differs:\n{xml}"));
+            }
+            certify(&s, &Options::lattice_only()).map_err(|e| e.to_string())?;
+            Ok(())
+        }));
+        match outcome {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => prop_assert!(false, "{e} on {edited:?}"),
+            Err(_) => prop_assert!(false, "panicked on {edited:?}"),
+        }
+    }
+
+    /// Motion traces: an edited bundled `rolls.csv` is refused (naming a
+    /// line or the header) or becomes a schedule that is certified.
+    #[test]
+    fn edited_motion_traces_are_refused_or_imported_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+        one_per_step in any::<bool>(),
+    ) {
+        use reconfcheck::interop::{GroundChoice, TraceOptions, VsLattice, read_config, read_trace, trace_to_schedule};
+        use reconfcheck::schedule::Length;
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let xml = std::fs::read_to_string(root.join("scenarios/visiblesim/rolls.xml")).unwrap();
+        let cfg = read_config(&xml, Path::new("rolls.xml"), VsLattice::Fcc).unwrap();
+        let edited = edited_model("scenarios/visiblesim/rolls.csv", &edits);
+        let opts = TraceOptions {
+            move_us: 400_000,
+            one_per_step,
+            ground: GroundChoice::Lowest,
+            lattice: VsLattice::Fcc,
+            spacing: Length::mm(3.6),
+        };
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            for config in [Some(&cfg), None] {
+                match read_trace(&edited).and_then(|rows| trace_to_schedule(&rows, config, &opts)) {
+                    Ok(s) => {
+                        s.validate().map_err(|e| e.to_string())?;
+                        certify(&s, &Options::lattice_only()).map_err(|e| e.to_string())?;
+                    }
+                    Err(e) if e.message.starts_with("line ") || e.message.contains("trace")
+                        || e.message.contains("start in one cell") => {}
+                    Err(e) => return Err(format!("names no line: {e}")),
+                }
+            }
+            Ok::<(), String>(())
+        }));
+        match outcome {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => prop_assert!(false, "{e} on {edited:?}"),
+            Err(_) => prop_assert!(false, "panicked on {edited:?}"),
+        }
+    }
+}

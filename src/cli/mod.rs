@@ -5,6 +5,7 @@
 
 pub mod b_study;
 pub mod density;
+pub mod interop;
 pub mod parallel;
 #[cfg(feature = "render")]
 pub mod pictures;

@@ -126,6 +126,7 @@ impl CsgShape {
             toks: lex(text)?,
             pos: 0,
             vars: HashMap::new(),
+            depth: 0,
         };
         let mut nodes = Vec::new();
         while p.pos < p.toks.len() {
@@ -181,7 +182,7 @@ enum Tok {
     Sym(char),
 }
 
-fn lex(text: &str) -> Result<Vec<(Tok, usize)>, InputError> {
+fn lex(text: &str) -> Result<Vec<(Tok, usize, usize)>, InputError> {
     let mut out = Vec::new();
     for (ln, line) in text.lines().enumerate() {
         let line_no = ln + 1;
@@ -200,22 +201,26 @@ fn lex(text: &str) -> Result<Vec<(Tok, usize)>, InputError> {
                     i += 1;
                 }
                 let t: String = cs[s..i].iter().collect();
-                let v = t
-                    .parse()
-                    .map_err(|_| InputError::new(format!("line {line_no}: bad number '{t}'")))?;
-                out.push((Tok::Num(v), line_no));
+                let v = t.parse().map_err(|_| {
+                    InputError::new(format!(
+                        "line {line_no}, column {}: bad number '{t}'",
+                        s + 1
+                    ))
+                })?;
+                out.push((Tok::Num(v), line_no, s + 1));
             } else if c.is_alphabetic() || c == '_' || c == '$' {
                 let s = i;
                 while i < cs.len() && (cs[i].is_alphanumeric() || cs[i] == '_' || cs[i] == '$') {
                     i += 1;
                 }
-                out.push((Tok::Id(cs[s..i].iter().collect()), line_no));
+                out.push((Tok::Id(cs[s..i].iter().collect()), line_no, s + 1));
             } else if "()[]{},;=+-*/".contains(c) {
-                out.push((Tok::Sym(c), line_no));
+                out.push((Tok::Sym(c), line_no, i + 1));
                 i += 1;
             } else {
                 return Err(InputError::new(format!(
-                    "line {line_no}: unexpected character '{c}'"
+                    "line {line_no}, column {}: unexpected character '{c}'",
+                    i + 1
                 )));
             }
         }
@@ -231,21 +236,37 @@ enum Val {
 }
 
 struct Parser {
-    toks: Vec<(Tok, usize)>,
+    toks: Vec<(Tok, usize, usize)>,
     pos: usize,
     vars: HashMap<String, f64>,
+    /// Current nesting of objects and parentheses (see [`MAX_DEPTH`]).
+    depth: usize,
 }
 
+/// Deepest nesting of objects or parenthesised expressions read: the
+/// parser and the solid's membership test recurse, so a file nested
+/// thousands of levels deep would overflow the stack (a crash, exit 134);
+/// it is refused with its position instead. No hand-written shape comes
+/// near 100 levels.
+pub const MAX_DEPTH: usize = 100;
+
 impl Parser {
-    fn line(&self) -> usize {
-        self.toks
+    fn err(&self, msg: impl std::fmt::Display) -> InputError {
+        let (line, col) = self
+            .toks
             .get(self.pos)
             .or(self.toks.last())
-            .map(|t| t.1)
-            .unwrap_or(0)
+            .map(|t| (t.1, t.2))
+            .unwrap_or((0, 0));
+        InputError::new(format!("line {line}, column {col}: {msg}"))
     }
-    fn err(&self, msg: impl std::fmt::Display) -> InputError {
-        InputError::new(format!("line {}: {msg}", self.line()))
+    /// Enters one nesting level, refusing beyond [`MAX_DEPTH`].
+    fn deeper(&mut self) -> Result<(), InputError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.err(format!("nested more than {MAX_DEPTH} levels deep")));
+        }
+        Ok(())
     }
     fn peek(&self) -> Option<&Tok> {
         self.toks.get(self.pos).map(|t| &t.0)
@@ -277,7 +298,7 @@ impl Parser {
         if self.eat(';') {
             return Ok(None);
         }
-        if let (Some(Tok::Id(name)), Some((Tok::Sym('='), _))) =
+        if let (Some(Tok::Id(name)), Some((Tok::Sym('='), _, _))) =
             (self.peek().cloned(), self.toks.get(self.pos + 1))
         {
             self.pos += 2;
@@ -290,11 +311,18 @@ impl Parser {
     }
 
     fn object(&mut self) -> Result<Node, InputError> {
+        self.deeper()?;
+        let node = self.object_inner();
+        self.depth -= 1;
+        node
+    }
+
+    fn object_inner(&mut self) -> Result<Node, InputError> {
         let Some(Tok::Id(name)) = self.next() else {
             self.pos -= 1;
             return Err(self.err("expected a CSG object"));
         };
-        let args = self.args()?;
+        let args = self.checked_args(&name)?;
         let num = |k: &str, pos: usize| -> Option<f64> {
             args.iter()
                 .find(|(n, _)| n.as_deref() == Some(k))
@@ -360,6 +388,73 @@ impl Parser {
         Ok(node)
     }
 
+    /// The arguments of `object`, refusing what this dialect does not
+    /// read — unknown names, extra positional arguments and positional
+    /// booleans — with their position. OpenSCAD and VisibleSim read
+    /// `cube([..], true)` as centred, `cube(20, 10, 2.1, true)` is no
+    /// cube of this dialect, and `cylinder(20, 30, 0)` is an OpenSCAD cone:
+    /// none of them may pass as something else.
+    fn checked_args(&mut self, object: &str) -> Result<Vec<(Option<String>, Val)>, InputError> {
+        let args = self.args_at()?;
+        let (named, positional): (&[&str], usize) = match object {
+            "cube" => (&["size", "center"], 1),
+            "sphere" => (&["r", "radius", "d"], 1),
+            "cylinder" => (
+                &[
+                    "h", "height", "r", "radius", "center", "r1", "r2", "d1", "d2",
+                ],
+                2,
+            ),
+            "translate" => (&[], 1),
+            "union" | "difference" | "intersection" => (&[], 0),
+            _ => return Ok(args.into_iter().map(|(n, v, _)| (n, v)).collect()),
+        };
+        let mut seen = 0;
+        let end = self.pos;
+        for (n, v, at) in &args {
+            self.pos = *at;
+            match n {
+                None if matches!(v, Val::Bool(_)) => {
+                    return Err(self.err(format!(
+                        "a positional true/false in {object}(…) is not read in this dialect \
+                         (OpenSCAD and VisibleSim take it as the centre flag): write center = true \
+                         or center = false"
+                    )));
+                }
+                None => {
+                    seen += 1;
+                    if seen > positional {
+                        let what = if object == "cylinder" && seen == 3 {
+                            " (OpenSCAD reads a third number as r2: a cone)".to_string()
+                        } else {
+                            String::new()
+                        };
+                        return Err(self.err(format!(
+                            "{object} takes at most {positional} positional argument(s){what}; \
+                             name the others"
+                        )));
+                    }
+                }
+                Some(k) if !named.contains(&k.as_str()) => {
+                    return Err(self.err(format!(
+                        "{object} has no argument '{k}' (known: {})",
+                        if named.is_empty() {
+                            "none named".to_string()
+                        } else {
+                            named.join(", ")
+                        }
+                    )));
+                }
+                Some(k) if k == "center" && !matches!(v, Val::Bool(_)) => {
+                    return Err(self.err("center must be true or false"));
+                }
+                Some(_) => {}
+            }
+        }
+        self.pos = end;
+        Ok(args.into_iter().map(|(n, v, _)| (n, v)).collect())
+    }
+
     fn block(&mut self) -> Result<Node, InputError> {
         if self.peek() == Some(&Tok::Sym('{')) {
             let mut c = self.children()?;
@@ -387,15 +482,17 @@ impl Parser {
         Ok(out)
     }
 
-    fn args(&mut self) -> Result<Vec<(Option<String>, Val)>, InputError> {
+    /// The arguments with the token index each starts at (for errors).
+    fn args_at(&mut self) -> Result<Vec<(Option<String>, Val, usize)>, InputError> {
         self.expect('(')?;
         let mut out = Vec::new();
         if self.eat(')') {
             return Ok(out);
         }
         loop {
+            let start = self.pos;
             let name = match (self.peek().cloned(), self.toks.get(self.pos + 1)) {
-                (Some(Tok::Id(n)), Some((Tok::Sym('='), _))) => {
+                (Some(Tok::Id(n)), Some((Tok::Sym('='), _, _))) => {
                     self.pos += 2;
                     Some(n)
                 }
@@ -418,7 +515,7 @@ impl Parser {
             } else {
                 Val::Num(self.expr()?)
             };
-            out.push((name, v));
+            out.push((name, v, start));
             if self.eat(')') {
                 return Ok(out);
             }
@@ -453,9 +550,16 @@ impl Parser {
     fn factor(&mut self) -> Result<f64, InputError> {
         match self.next() {
             Some(Tok::Num(v)) => Ok(v),
-            Some(Tok::Sym('-')) => Ok(-self.factor()?),
+            Some(Tok::Sym('-')) => {
+                self.deeper()?;
+                let v = self.factor();
+                self.depth -= 1;
+                Ok(-v?)
+            }
             Some(Tok::Sym('(')) => {
+                self.deeper()?;
                 let v = self.expr()?;
+                self.depth -= 1;
                 self.expect(')')?;
                 Ok(v)
             }
@@ -533,10 +637,73 @@ mod tests {
     }
 
     #[test]
+    fn what_this_dialect_does_not_read_is_refused_with_line_and_column() {
+        let cases = [
+            (
+                "cube([12, 42, 13.5], true);",
+                "line 1, column 22",
+                "positional true",
+            ),
+            (
+                "\ncube(20, 10, 2.1, true);",
+                "line 2, column 10",
+                "at most 1 positional",
+            ),
+            ("cylinder(20, 30, 0);", "line 1, column 18", "a cone"),
+            (
+                "sphere(r = 3, $fn = 40);",
+                "line 1, column 15",
+                "no argument '$fn'",
+            ),
+            ("cube(3, center = 1);", "line 1, column 9", "center must be"),
+            (
+                "union(3) { cube(3); }",
+                "line 1, column 7",
+                "union takes at most 0",
+            ),
+        ];
+        for (text, at, what) in cases {
+            let e = CsgShape::parse("t", text).unwrap_err();
+            assert!(
+                e.message.contains(at) && e.message.contains(what),
+                "{text}: {}",
+                e.message
+            );
+        }
+        // Named arguments still read as before.
+        let c = CsgShape::parse("t", "cylinder(h = 2, r = 3, center = true);").unwrap();
+        assert!(c.root.contains(DVec3::new(2.9, 0.0, -0.9)));
+    }
+
+    /// 10,000 nested `union()`s (or parentheses, or minus signs) used to
+    /// overflow the stack; any depth is now read or refused as input.
+    #[test]
+    fn any_nesting_depth_is_read_or_refused_without_a_crash() {
+        for n in [10, MAX_DEPTH - 1] {
+            let text = format!("{}cube(1);{}", "union() {".repeat(n), "}".repeat(n));
+            assert!(CsgShape::parse("t", &text).is_ok(), "{n}");
+        }
+        let deep = [
+            format!(
+                "{}cube(1);{}",
+                "union() {".repeat(10_000),
+                "}".repeat(10_000)
+            ),
+            format!("cube({}1{});", "(".repeat(10_000), ")".repeat(10_000)),
+            format!("cube({}1);", "-".repeat(10_000)),
+            format!("{}cube(1);", "translate([0,0,0]) ".repeat(10_000)),
+        ];
+        for text in deep {
+            let e = CsgShape::parse("t", &text).unwrap_err();
+            assert!(e.message.contains("nested more than"), "{}", e.message);
+        }
+    }
+
+    #[test]
     fn unsupported_operations_are_named_with_their_line() {
         let e = CsgShape::parse("r", "cube(3);\nrotate([0,0,45]) cube(2);").unwrap_err();
         assert!(
-            e.message.contains("line 2") && e.message.contains("rotate"),
+            e.message.contains("line 2, column 1") && e.message.contains("rotate"),
             "{}",
             e.message
         );

@@ -18,6 +18,7 @@ pub mod polytree;
 #[allow(clippy::module_inception)]
 pub mod scaffold;
 pub mod shape;
+pub mod vs_csg;
 
 use super::{Generator, parameters};
 use crate::error::InputError;
@@ -124,6 +125,15 @@ pub fn build_scaffold(shape: &ShapeSpec, b: u32) -> Result<Scaffold, InputError>
                 b,
                 (Skew::new(-l, -l, 0), Skew::new(l, l, l)),
             )
+        }
+        ShapeSpec::Csg { path } if path.extension().is_some_and(|e| e == "xml") => {
+            // A VisibleSim configuration: its CSG target, read as the
+            // authors' scaffolding_csg application reads it.
+            let s = vs_csg::VsCsgShape::load(path)?;
+            let bounds = s.skew_bounds().ok_or_else(|| {
+                InputError::new("the CSG target contains no grid cell").in_file(path)
+            })?;
+            Scaffold::build(&s as &dyn Shape, b, bounds).map_err(|e| e.in_file(path))
         }
         ShapeSpec::Csg { path } => {
             let s = csg::CsgShape::load(path)?;
