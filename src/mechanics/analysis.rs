@@ -8,7 +8,9 @@
 //! `W = m·g`; interface stiffnesses relative to the axial one (the absolute
 //! modulus and layer thickness cancel out of the loads). Results are in SI.
 
-use super::capacity::{ConnectorLoad, Mode, corner_ratio, overloaded, severity, utilisation};
+use super::capacity::{
+    CORNER_FREE_BELOW, ConnectorLoad, Mode, corner_ratio, overloaded, severity, utilisation,
+};
 use super::direct::Factor;
 use super::limit::{self, Connectors};
 use super::model::{Capacity, Model};
@@ -846,7 +848,11 @@ impl Analyzer {
             j_out.worst = j_out.worst.max(u);
             // A witness must also be carried by the limit analysis's
             // corner forces (torsion on a square pressed off-centre).
-            let r = severity(corner_ratio(&load, cap));
+            let r = if u > CORNER_FREE_BELOW {
+                severity(corner_ratio(&load, cap))
+            } else {
+                0.0
+            };
             if self.settings.corner_gate && overloaded(r) {
                 j_out.gate = j_out.gate.max(r);
                 // The elastic forces scaled down by `k` keep the centre of

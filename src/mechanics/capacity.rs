@@ -132,6 +132,14 @@ pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
     }
 }
 
+/// Below this utilisation the corner construction always carries a load
+/// ([`corner_ratio`] ≤ 0.82), so the hot path need not evaluate it: with
+/// `u ≤ k` the centre of pressure is within `k·a` of the centre on each
+/// axis, the lever `ρC/J` at most `√2/(L(1 − k))`, and the corner demand at
+/// most `(|V| + 0.541·|T|/(r̄L))/(1 − k) ≤ k·μC/(1 − k)`, within `μC` for
+/// `k ≤ ½`.
+pub const CORNER_FREE_BELOW: f64 = 0.45;
+
 /// Whether the corner forces of the limit analysis ([`super::limit`]) can
 /// carry `load`, as a ratio (≤ 1: they can). The utilisation's friction
 /// chord treats torsion apart from where the square bears; the corner
@@ -168,23 +176,37 @@ pub fn corner_ratio(load: &ConnectorLoad, cap: &Capacity) -> f64 {
         // Bending beyond the square: no clamp distribution exists.
         return f64::INFINITY;
     }
-    let mut j = 0.0;
-    let mut rho: f64 = 0.0;
-    for (su, sv) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-        let c = clamp / 4.0 * (1.0 + su * eu / a) * (1.0 + sv * ev / a);
-        let d2 = (su * a - eu).powi(2) + (sv * a - ev).powi(2);
-        j += c * d2;
-        if c > 0.0 {
-            rho = rho.max(d2.sqrt());
+    // In units of a: the bilinear spread gives J = C·a²·(2 − x² − y²)
+    // (x, y the centre of pressure over a), and the farthest loaded corner
+    // is the opposite one while the centre is inside the square.
+    let (x, y) = (eu / a, ev / a);
+    let lever = if x < 1.0 && y < 1.0 {
+        ((1.0 + x) * (1.0 + x) + (1.0 + y) * (1.0 + y)).sqrt() / (a * (2.0 - x * x - y * y))
+    } else {
+        // On an edge: the corners left loaded, summed out.
+        let mut j = 0.0;
+        let mut rho: f64 = 0.0;
+        for (su, sv) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let c = 0.25 * (1.0 + su * x) * (1.0 + sv * y);
+            let d2 = (su - x).powi(2) + (sv - y).powi(2);
+            j += c * d2;
+            if c > 0.0 {
+                rho = rho.max(d2.sqrt());
+            }
         }
-    }
-    let torsion = t + eu.hypot(ev) * v;
+        if j > 0.0 {
+            rho / (a * j)
+        } else {
+            f64::INFINITY
+        }
+    };
+    // (sqrt of a sum of squares: hypot's overflow care is not needed
+    // for lengths within the square, and it is slow on this hot path.)
+    let torsion = t + (eu * eu + ev * ev).sqrt() * v;
     let demand = if torsion == 0.0 {
         v
-    } else if j > 0.0 {
-        v + torsion * rho * clamp / j
     } else {
-        f64::INFINITY
+        v + torsion * lever
     };
     demand / (cap.friction * clamp)
 }
@@ -364,6 +386,22 @@ mod tests {
             assert!((mz - torsion).abs() < 1e-9 * clamp * a, "{mz} vs {torsion}");
         }
         assert!(checked > 1000, "{checked}");
+        // Below CORNER_FREE_BELOW the ratio never binds (the hot path skips it).
+        for _ in 0..20_000 {
+            let load = ConnectorLoad {
+                axial: (rnd() * 2.0 - 1.5) * c,
+                shear: rnd() * c,
+                torsion: (rnd() * 2.0 - 1.0) * c * a,
+                moment_u: (rnd() * 2.0 - 1.0) * c * a,
+                moment_v: (rnd() * 2.0 - 1.0) * c * a,
+            };
+            for bending in [Bending::RigidHinge, Bending::Elastic] {
+                let cap = Capacity { bending, ..cap };
+                if utilisation(&load, &cap).0 <= CORNER_FREE_BELOW {
+                    assert!(corner_ratio(&load, &cap) <= 0.83, "{load:?}");
+                }
+            }
+        }
     }
 
     #[test]
