@@ -20,8 +20,15 @@
 //!   `gridSize` only (on the skewed lattice layer z spans x, y from
 //!   −⌊z/2⌋, as `SkewFCCLattice::getGridLowerBounds` says).
 //!
-//! Not read (refused with line and column): `rotate` (VisibleSim's
-//! rotation matrices are not reproduced here), a one-number `cube(s)`
+//! * `rotate(x, y, z)` (degrees) is `R = R_x(x)·R_y(y)·R_z(z)` (VisibleSim's
+//!   `CSGRotate`: `rotate = rotate*mat` for x, then y, then z, row-major
+//!   matrices acting on column vectors); a point is inside when the child
+//!   contains `R⁻¹·p`; its bounding box is that of the two corners `R·P0`
+//!   and `R·P1` only (VisibleSim's, not the box of the rotated solid: a
+//!   45° turn of a cube gives a flat box — reproduced, since the target's
+//!   cells depend on it).
+//!
+//! Not read (refused with line and column): a one-number `cube(s)`
 //! (VisibleSim reads it as a degenerate cube), and anything else.
 
 use super::shape::{Shape, Skew};
@@ -45,6 +52,8 @@ pub enum VsNode {
     Sphere(f64),
     Translate(DVec3, Box<VsNode>),
     Scale(DVec3, Box<VsNode>),
+    /// `R` and its inverse (see the module doc).
+    Rotate(glam::DMat3, glam::DMat3, Box<VsNode>),
     Union(Vec<VsNode>),
     Difference(Vec<VsNode>),
     Intersection(Vec<VsNode>),
@@ -61,6 +70,7 @@ impl VsNode {
             VsNode::Sphere(r) => p.length() <= *r,
             VsNode::Translate(v, c) => c.contains(p - *v),
             VsNode::Scale(s, c) => c.contains(p / *s),
+            VsNode::Rotate(_, inv, c) => c.contains(*inv * p),
             VsNode::Union(c) => c.iter().any(|n| n.contains(p)),
             VsNode::Difference(c) => {
                 c.first().is_some_and(|f| f.contains(p)) && !c[1..].iter().any(|n| n.contains(p))
@@ -84,6 +94,11 @@ impl VsNode {
             VsNode::Scale(s, c) => {
                 let (a, b) = c.bounding_box();
                 (a * *s, b * *s)
+            }
+            VsNode::Rotate(r, _, c) => {
+                let (a, b) = c.bounding_box();
+                let (p0, p1) = (*r * a, *r * b);
+                (p0.min(p1), p0.max(p1))
             }
             VsNode::Union(c) => c
                 .iter()
@@ -266,7 +281,7 @@ impl Parser {
                 self.end()?;
                 VsNode::Sphere(r)
             }
-            "translate" | "scale" => {
+            "translate" | "scale" | "rotate" => {
                 let v = three(self, &nums)?;
                 // VisibleSim skips ';' like a space: `scale([2,2,2]); sphere(10);`
                 // scales the sphere.
@@ -281,6 +296,12 @@ impl Parser {
                 let child = Box::new(self.object()?);
                 if name == "translate" {
                     VsNode::Translate(v, child)
+                } else if name == "rotate" {
+                    let deg = |a: f64| a.to_radians();
+                    let r = glam::DMat3::from_rotation_x(deg(v.x))
+                        * glam::DMat3::from_rotation_y(deg(v.y))
+                        * glam::DMat3::from_rotation_z(deg(v.z));
+                    VsNode::Rotate(r, r.inverse(), child)
                 } else {
                     if v.cmpeq(DVec3::ZERO).any() {
                         return Err(at_start(self, "scale by zero".into()));
@@ -316,20 +337,12 @@ impl Parser {
                     _ => VsNode::Intersection(c),
                 }
             }
-            "rotate" => {
-                return Err(at_start(
-                    self,
-                    "rotate is not read: VisibleSim's rotation convention is not reproduced \
-                     (the target would be approximated)"
-                        .into(),
-                ));
-            }
             other => {
                 return Err(at_start(
                     self,
                     format!(
                         "'{other}' is not a VisibleSim CSG object (known: cube, cylinder, sphere, \
-                         translate, scale, color, union, difference, intersection)"
+                         translate, scale, rotate, color, union, difference, intersection)"
                     ),
                 ));
             }
@@ -665,10 +678,32 @@ mod tests {
     }
 
     #[test]
+    fn rotate_is_visiblesims_rx_ry_rz_with_its_two_corner_bounding_box() {
+        // A quarter turn about z takes the long x side of the cube to y.
+        let s = parse_vs_csg("rotate([0,0,90]) cube([4,2,2]);", 1).unwrap();
+        assert!(s.contains(DVec3::new(0.0, 1.9, 0.0)));
+        assert!(!s.contains(DVec3::new(1.9, 0.0, 0.0)));
+        let (a, b) = s.bounding_box();
+        assert!((a - DVec3::new(-1.0, -2.0, -1.0)).length() < 1e-12, "{a}");
+        assert!((b - DVec3::new(1.0, 2.0, 1.0)).length() < 1e-12, "{b}");
+        // The order: x first, then y, then z (R = Rx·Ry·Rz acting on the
+        // child's points). Rx(90)·Rz(90) takes the child's +x to +z.
+        let s = parse_vs_csg("rotate(90, 0, 90) translate([3,0,0]) sphere(1);", 1).unwrap();
+        assert!(s.contains(DVec3::new(0.0, 0.0, 3.0)), "{s:?}");
+        assert!(!s.contains(DVec3::new(0.0, 3.0, 0.0)));
+        // VisibleSim's box is that of the two rotated corners only: a 45°
+        // turn of a cube is flat in x (the true box would be ±√2).
+        let s = parse_vs_csg("rotate([0,0,45]) cube([2,2,2]);", 1).unwrap();
+        let (a, b) = s.bounding_box();
+        assert!(a.x.abs() < 1e-12 && b.x.abs() < 1e-12, "{a} {b}");
+        assert!((b.y - std::f64::consts::SQRT_2).abs() < 1e-12);
+    }
+
+    #[test]
     fn refusals_name_the_files_line() {
-        let e = parse_vs_csg("\nunion() {\n rotate([0,0,45]) cube([1,1,1]);\n}", 10).unwrap_err();
+        let e = parse_vs_csg("\nunion() {\n polyhedron([0,0,45]);\n}", 10).unwrap_err();
         assert!(
-            e.message.contains("CSG line 12") && e.message.contains("rotate"),
+            e.message.contains("CSG line 12") && e.message.contains("polyhedron"),
             "{}",
             e.message
         );
