@@ -122,8 +122,16 @@ mod mpi_session {
             Ok(c) => *c,
             Err(e) => e.exit_code(),
         };
+        // Rank 0 says why before the broadcast releases the others: once
+        // one process exits non-zero, mpirun aborts the rest, and rank 0's
+        // message would be lost if it came later.
+        if place.0 == 0
+            && let Err(e) = &result
+        {
+            eprintln!("error: {e}");
+        }
         comm().process_at_rank(0).broadcast_into(&mut code);
-        if place.0 == 0 { result } else { Ok(code) }
+        Ok(code)
     }
 
     /// Runs each process's share of the ranges and gathers them on rank 0.
