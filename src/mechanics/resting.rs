@@ -478,8 +478,9 @@ fn an_elastic_witness_the_corners_cannot_carry_goes_to_the_limit_analysis() {
     // Resting on the ground, every link within the utilisation's chord, but
     // one ground contact twisted while pressed off-centre: the corner forces
     // of the limit analysis cannot carry that field, so it is no witness.
-    // (Found by a search over 40,000 random structures: the gate sends 3 %
-    // of resting ones to the limit analysis, which stood every one of them.)
+    // (Found by a search over 40,000 random structures, resting or held by
+    // a fixed module: the gate sends 3 % of them to the limit analysis,
+    // which stood every one of them.)
     let model = Model::default_catom();
     let s = fcc(&[
         c(0, 0, 0),
