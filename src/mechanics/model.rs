@@ -422,7 +422,7 @@ impl Model {
             actuator,
             poisson: nu,
         };
-        m.check_derived().map_err(bad)?;
+        m.check_derived().map_err(|e| bad(e.message))?;
         Ok(m)
     }
 
@@ -430,7 +430,7 @@ impl Model {
     /// weight, the capacities and their ratios to the weight must be normal
     /// positive floats (not 0 by underflow, not infinite by overflow), so
     /// that no verdict can follow from a number that vanished.
-    pub fn check_derived(&self) -> Result<(), String> {
+    pub fn check_derived(&self) -> Result<(), InputError> {
         let w = self.weight();
         let normal = |v: f64| v.is_normal() && v > 0.0;
         let checks = [
@@ -462,10 +462,10 @@ impl Model {
         ];
         for (what, v) in checks {
             if !normal(v) {
-                return Err(format!(
+                return Err(InputError::new(format!(
                     "{what} is {v:e} at spacing {} m: the arithmetic underflows or overflows",
                     self.spacing
-                ));
+                )));
             }
         }
         for (what, mu) in [
@@ -474,22 +474,22 @@ impl Model {
             ("actuator.friction", self.hold().friction),
         ] {
             if !normal(mu) {
-                return Err(format!(
+                return Err(InputError::new(format!(
                     "{what} is {mu}: a friction coefficient must be positive and finite"
-                ));
+                )));
             }
         }
         if !(self.ground.pressure.is_finite() && self.ground.pressure >= 0.0) {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "ground.pressure_kpa gives {} Pa: not a pressure",
                 self.ground.pressure
-            ));
+            )));
         }
         if self.ground.pressure > 0.0 && !normal(self.ground.tension() / w) {
-            return Err(format!(
+            return Err(InputError::new(format!(
                 "ground capacity over weight (ground.pressure_kpa) is {:e}: the arithmetic underflows or overflows",
                 self.ground.tension() / w
-            ));
+            )));
         }
         Ok(())
     }
@@ -530,8 +530,8 @@ impl Model {
         let m = self.at_spacing(d);
         m.check_derived().map_err(|e| {
             InputError::new(format!(
-                "model '{}' at the schedule's spacing {d} m: {e}",
-                self.name
+                "model '{}' at the schedule's spacing {d} m: {}",
+                self.name, e.message
             ))
         })?;
         Ok(m)
