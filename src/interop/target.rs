@@ -3,10 +3,9 @@
 //! own CSG model, so that scaffold scenarios can name a VisibleSim file).
 
 use super::visiblesim::{VsConfig, VsLattice};
-use crate::algorithms::scaffold::vs_csg::parse_vs_csg;
+use crate::algorithms::scaffold::vs_csg::{parse_vs_csg, target_shift};
 use crate::error::InputError;
 use crate::lattice::Cell;
-use glam::DVec3;
 
 /// The cells of a configuration's CSG target, as VisibleSim's `TargetCSG`
 /// decides them (in this crate's frame), or `None` without a CSG target.
@@ -19,41 +18,7 @@ pub fn target_cells(cfg: &VsConfig, lattice: VsLattice) -> Result<Option<Vec<Cel
         InputError::new(format!("line {line}, element <csg>: no content attribute"))
     })?;
     let root = parse_vs_csg(content, line)?;
-    let flag = |k: &str, default: bool| -> Result<bool, InputError> {
-        match attrs.get(k).map(String::as_str) {
-            None => Ok(default),
-            Some("true" | "1") => Ok(true),
-            Some("false" | "0") => Ok(false),
-            Some(o) => Err(InputError::new(format!(
-                "line {line}, element <csg>: {k}=\"{o}\" is not true or false"
-            ))),
-        }
-    };
-    let translate = match attrs.get("translate") {
-        None => DVec3::ZERO,
-        Some(s) => {
-            let v: Vec<f64> = s
-                .split(',')
-                .map(|t| t.trim().parse::<f64>())
-                .collect::<Result<_, _>>()
-                .ok()
-                .filter(|v: &Vec<f64>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
-                .ok_or_else(|| {
-                    InputError::new(format!(
-                        "line {line}, element <csg>: translate '{s}' is not three numbers"
-                    ))
-                })?;
-            DVec3::new(v[0], v[1], v[2])
-        }
-    };
-    let mut p0 = if flag("boundingBox", true)? {
-        root.bounding_box().0
-    } else {
-        DVec3::ZERO
-    };
-    if flag("offset", false)? {
-        p0 -= DVec3::ONE;
-    }
+    let shift = target_shift(&root, |k| attrs.get(k).map(String::as_str), line)?;
     let g = cfg.grid_size;
     let mut cells = Vec::new();
     // The grid is the same straight box in our frame for both lattices
@@ -63,7 +28,7 @@ pub fn target_cells(cfg: &VsConfig, lattice: VsLattice) -> Result<Option<Vec<Cel
             for x in 0..g[0] {
                 let cell = Cell::new(x, y, z);
                 let p = lattice.to_grid(cell);
-                let w = lattice.unscaled_world(p) + p0 - translate;
+                let w = lattice.unscaled_world(p) + shift;
                 if root.contains(w) {
                     cells.push(cell);
                 }

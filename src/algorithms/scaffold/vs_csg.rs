@@ -35,6 +35,45 @@ use super::shape::{Shape, Skew};
 use crate::error::InputError;
 use glam::DVec3;
 
+/// Where VisibleSim's `TargetCSG` asks its solid about a grid cell, less
+/// the cell's unscaled world position: `bb.P0 − translate` (see the module
+/// doc), from the `<csg>` element's `boundingBox`, `offset` and `translate`
+/// attributes (`attr`), at `line` of its file.
+pub fn target_shift<'a>(
+    root: &VsNode,
+    attr: impl Fn(&str) -> Option<&'a str>,
+    line: usize,
+) -> Result<DVec3, InputError> {
+    let here = |m: String| InputError::new(format!("line {line}, element <csg>: {m}"));
+    let flag = |k: &str, default: bool| match attr(k) {
+        None => Ok(default),
+        Some("true" | "1") => Ok(true),
+        Some("false" | "0") => Ok(false),
+        Some(o) => Err(here(format!("{k}=\"{o}\" is not true or false"))),
+    };
+    let translate = match attr("translate") {
+        None => DVec3::ZERO,
+        Some(s) => {
+            let v: Vec<f64> = s
+                .split(',')
+                .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+                .collect::<Option<_>>()
+                .filter(|v: &Vec<f64>| v.len() == 3)
+                .ok_or_else(|| here(format!("translate '{s}' is not three numbers")))?;
+            DVec3::new(v[0], v[1], v[2])
+        }
+    };
+    let mut p0 = if flag("boundingBox", true)? {
+        root.bounding_box().0
+    } else {
+        DVec3::ZERO
+    };
+    if flag("offset", false)? {
+        p0 -= DVec3::ONE;
+    }
+    Ok(p0 - translate)
+}
+
 /// Deepest nesting of groups or expressions read (see the scaffold CSG
 /// parser's `MAX_DEPTH`): deeper input is refused, never a stack overflow.
 pub const MAX_VS_DEPTH: usize = 100;
@@ -565,32 +604,7 @@ impl VsCsgShape {
             .attribute("content")
             .ok_or_else(|| here("no content".into()))?;
         let root = parse_vs_csg(content, line).map_err(|e| e.in_file(path))?;
-        let flag = |k: &str, default: bool| match csg.attribute(k) {
-            None => Ok(default),
-            Some("true" | "1") => Ok(true),
-            Some("false" | "0") => Ok(false),
-            Some(o) => Err(here(format!("{k}=\"{o}\" is not true or false"))),
-        };
-        let translate = match csg.attribute("translate") {
-            None => DVec3::ZERO,
-            Some(s) => {
-                let v: Vec<f64> = s
-                    .split(',')
-                    .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
-                    .collect::<Option<_>>()
-                    .filter(|v: &Vec<f64>| v.len() == 3)
-                    .ok_or_else(|| here(format!("translate '{s}' is not three numbers")))?;
-                DVec3::new(v[0], v[1], v[2])
-            }
-        };
-        let mut p0 = if flag("boundingBox", true)? {
-            root.bounding_box().0
-        } else {
-            DVec3::ZERO
-        };
-        if flag("offset", false)? {
-            p0 -= DVec3::ONE;
-        }
+        let shift = target_shift(&root, |k| csg.attribute(k), line).map_err(|e| e.in_file(path))?;
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -598,7 +612,7 @@ impl VsCsgShape {
         Ok(VsCsgShape {
             name,
             root,
-            shift: p0 - translate,
+            shift,
             grid_size,
         })
     }
