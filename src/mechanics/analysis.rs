@@ -249,6 +249,21 @@ struct LinkBlocks {
     kab: Block,
 }
 
+impl LinkBlocks {
+    /// The interface force `D·(G_b q_b − G_a q_a)` (units `W`, `W·d`) from
+    /// the displacements of the free sides (`None`: fixed or the ground).
+    fn interface_force(&self, qa: Option<&Vec6>, qb: Option<&Vec6>) -> Vec6 {
+        let mut e = Vec6::zeros();
+        if let Some(qa) = qa {
+            e -= self.ga * qa;
+        }
+        if let Some(qb) = qb {
+            e += self.gb * qb;
+        }
+        self.d * e
+    }
+}
+
 fn v3(v: DVec3) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(v.x, v.y, v.z)
 }
@@ -278,13 +293,8 @@ fn link_stiffness(link: &Link, k: &Springs) -> Block {
 fn body_loads(s: &Structure, pose: Option<usize>) -> Vec<Vec6> {
     let g = s.gravity;
     let mut f = vec![Vec6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0); s.bodies.len()];
-    for h in &s.hanging {
-        let p = s.bodies[h.pivot].centre;
-        let r = match pose {
-            Some(k) => h.path[k.min(h.path.len() - 1)] - p,
-            None => worst_lever(h.path.iter().map(|c| *c - p), g),
-        };
-        let m = r.cross(g);
+    for (i, h) in s.hanging.iter().enumerate() {
+        let m = mover_moment(s, i, pose);
         f[h.pivot] += Vec6::new(g.x, g.y, g.z, m.x, m.y, m.z);
     }
     f
@@ -300,17 +310,28 @@ fn local_loads(s: &Structure, pose: Option<usize>, local: &[u32]) -> Vec<Vec6> {
         .collect()
 }
 
-/// Mover `h`'s moment on its pivot at `pose`, less its reference one.
-fn moment_change(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
+/// The smaller factor; a NaN (a failed solve) sticks, so that it reads as
+/// overloaded wherever it ends up.
+fn lowest(x: f64, y: f64) -> f64 {
+    if x.is_nan() || y.is_nan() {
+        f64::NAN
+    } else {
+        x.min(y)
+    }
+}
+
+/// Mover `h`'s moment on its pivot (units `W·d`) at sample `pose` of its
+/// path, or (`None`) at its reference pose, the largest horizontal lever —
+/// the moment [`body_loads`] puts on the pivot.
+fn mover_moment(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
     let hg = &s.hanging[h];
     let p = s.bodies[hg.pivot].centre;
     let g = s.gravity;
-    let at = |r: DVec3| r.cross(g);
-    let reference = at(worst_lever(hg.path.iter().map(|c| *c - p), g));
-    match pose {
-        Some(k) => at(hg.path[k.min(hg.path.len() - 1)] - p) - reference,
-        None => DVec3::ZERO,
-    }
+    let r = match pose {
+        Some(k) => hg.path[k.min(hg.path.len() - 1)] - p,
+        None => worst_lever(hg.path.iter().map(|c| *c - p), g),
+    };
+    r.cross(g)
 }
 
 /// The offset with the largest horizontal lever (component across gravity);
@@ -430,11 +451,7 @@ impl Analyzer {
     }
 
     fn capacity(&self, link: &Link) -> &Capacity {
-        if link.is_ground() {
-            &self.model.ground
-        } else {
-            &self.model.connector
-        }
+        self.model.capacity_of(link.is_ground())
     }
 
     /// Analyses one structure.
@@ -594,14 +611,7 @@ impl Analyzer {
         let sf_of = |q_local: &[Vec6]| -> Vec<Vec6> {
             plan.iter()
                 .map(|(lb, a, b)| {
-                    let mut e = Vec6::zeros();
-                    if let Some(a) = a {
-                        e -= lb.ga * q_local[*a];
-                    }
-                    if let Some(b) = b {
-                        e += lb.gb * q_local[*b];
-                    }
-                    lb.d * e
+                    lb.interface_force(a.map(|a| &q_local[a]), b.map(|b| &q_local[b]))
                 })
                 .collect()
         };
@@ -642,11 +652,13 @@ impl Analyzer {
             no_witness(&mut screen, poses);
             return (screen, reference);
         };
-        let basis: Vec<(usize, DVec3, Vec<Vec6>)> = if superpose {
+        // Per unit solution: its mover, axis, the mover's reference moment
+        // (taken once, not per pose) and the interface forces.
+        let basis: Vec<(usize, DVec3, DVec3, Vec<Vec6>)> = if superpose {
             units
                 .into_iter()
                 .zip(solutions.iter().map(|q_k| sf_of(q_k)))
-                .map(|((h, e), sf)| (h, e, sf))
+                .map(|((h, e), sf)| (h, e, mover_moment(s, h, None), sf))
                 .collect()
         } else {
             Vec::new()
@@ -663,8 +675,8 @@ impl Analyzer {
                 None => sf.clone_from(&sf_reference),
                 Some(_) if superpose => {
                     sf.clone_from(&sf_reference);
-                    for (h, e, sf_b) in &basis {
-                        let c = moment_change(s, *h, pose).dot(*e);
+                    for (h, e, reference, sf_b) in &basis {
+                        let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
                         if c != 0.0 {
                             sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                         }
@@ -918,19 +930,12 @@ impl Analyzer {
             links: &comps.links[c],
         };
         // A NaN (solver failure) sticks: it reads as overloaded everywhere.
-        let lower = |x: f64, y: f64| {
-            if x.is_nan() || y.is_nan() {
-                f64::NAN
-            } else {
-                x.min(y)
-            }
-        };
         for &(pose, _) in failing {
             let loads = body_loads(s, pose);
             let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
             // (Held by a fixed module, the rigid case needs no solve.)
             out.runs += usize::from(rigid.iterations > 0);
-            out.rigid = lower(out.rigid, rigid.lambda);
+            out.rigid = lowest(out.rigid, rigid.lambda);
         }
         for (i, &(pose, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
@@ -939,14 +944,14 @@ impl Analyzer {
             let loads = body_loads(s, pose);
             let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
             out.runs += 1;
-            out.capacities = lower(out.capacities, cap.lambda);
+            out.capacities = lowest(out.capacities, cap.lambda);
             if cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // The step fails here. The poses not analysed are counted
                 // at their bounds: the factor reported is then a lower
                 // bound of the true smallest (1/λ an upper bound), never
                 // more optimistic.
                 if let Some(&(_, next)) = failing.get(i + 1) {
-                    out.capacities = lower(out.capacities, 1.0 / next);
+                    out.capacities = lowest(out.capacities, 1.0 / next);
                 }
                 break;
             }
@@ -1045,11 +1050,7 @@ impl Analyzer {
         for (c, l) in limits {
             // The smallest factor; a failed solve (NaN) sticks.
             let lf = l.capacities;
-            out.load_factor = Some(match out.load_factor {
-                Some(x) if x.is_nan() => x,
-                Some(x) if !lf.is_nan() => x.min(lf),
-                _ => lf,
-            });
+            out.load_factor = Some(out.load_factor.map_or(lf, |x| lowest(x, lf)));
             if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.
@@ -1124,16 +1125,8 @@ impl Analyzer {
     /// and `W·d`) from the displacements `q` (every body indexed).
     fn link_sf(&mut self, s: &Structure, l: &Link, q: &[Vec6], sliding: bool) -> Vec6 {
         let lb = self.link_blocks(s, l, sliding);
-        let mut e = Vec6::zeros();
-        if !s.bodies[l.a].fixed {
-            e -= lb.ga * q[l.a];
-        }
-        if let End::Body(b) = l.b
-            && !s.bodies[b].fixed
-        {
-            e += lb.gb * q[b];
-        }
-        lb.d * e
+        let free = |b: usize| (!s.bodies[b].fixed).then(|| &q[b]);
+        lb.interface_force(free(l.a), l.b.body().and_then(free))
     }
 
     /// The link's load in its frame, and the force and moment side `a`

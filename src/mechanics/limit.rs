@@ -195,11 +195,7 @@ struct Frame<'a> {
 }
 
 fn capacity<'m>(s: &Structure, model: &'m Model, li: usize) -> &'m Capacity {
-    if s.links[li].is_ground() {
-        &model.ground
-    } else {
-        &model.connector
-    }
+    model.capacity_of(s.links[li].is_ground())
 }
 
 /// Equilibrium rows: Σ (corner forces on the group) + λ·load = 0.

@@ -537,6 +537,16 @@ impl Model {
         Ok(m)
     }
 
+    /// The capacity of a link: the ground's for a ground contact, the
+    /// connector's otherwise.
+    pub fn capacity_of(&self, ground: bool) -> &Capacity {
+        if ground {
+            &self.ground
+        } else {
+            &self.connector
+        }
+    }
+
     /// The same model with another connector pressure (Pa) and bending rule.
     pub fn with_connector(&self, pressure: f64, bending: Bending) -> Model {
         let mut m = self.clone();

@@ -84,11 +84,7 @@ fn lp_stands(s: &Structure, model: &Model, joints: Joints, pyramid: Pyramid) -> 
                 d
             };
             for (j, f) in dirs.iter().enumerate() {
-                let other = match l.b {
-                    End::Body(b) => Some(b),
-                    End::Ground(_) => None,
-                };
-                for (body, sign) in [(Some(l.a), 1.0), (other, -1.0)] {
+                for (body, sign) in [(Some(l.a), 1.0), (l.b.body(), -1.0)] {
                     let Some(b) = body.filter(|&b| row_of[b] != usize::MAX) else {
                         continue;
                     };
