@@ -167,8 +167,15 @@ fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
         out.metrics.insert("load_factor".into(), lf);
     }
     // Where the limit analysis judged, its load factor says by how much.
+    let at_most = if a.load_factor_partial {
+        "at most "
+    } else {
+        ""
+    };
     let limit = |what: &str| match a.load_factor {
-        Some(lf) if lf.is_finite() => format!("{what} (limit analysis: load factor {lf:.3})"),
+        Some(lf) if lf.is_finite() => {
+            format!("{what} (limit analysis: load factor {at_most}{lf:.3})")
+        }
         Some(_) => format!("{what} (limit analysis failed to solve: not certified)"),
         None => what.to_string(),
     };
@@ -183,6 +190,9 @@ fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
                 a,
             );
             out.violations.push(match a.load_factor {
+                Some(lf) if lf.is_finite() && a.load_factor_partial => v
+                    .detail("load_factor", lf)
+                    .detail("load_factor_is_upper_bound", true),
                 Some(lf) if lf.is_finite() => v.detail("load_factor", lf),
                 _ => v,
             });

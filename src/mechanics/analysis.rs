@@ -87,6 +87,10 @@ pub struct Analysis {
     /// The smallest load factor `λ` of the components the elastic screen
     /// could not clear (`None`: the screen cleared every one).
     pub load_factor: Option<f64>,
+    /// Some component had failed at a pose already, and a pose with no
+    /// bound on its factor was left unanalysed: the true smallest factor
+    /// may be lower than `load_factor` (the verdict stands).
+    pub load_factor_partial: bool,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
     pub critical: Option<Critical>,
@@ -160,6 +164,9 @@ struct LimitOutcome {
     /// The screen's utilisation at the poses it cleared.
     admissible: f64,
     runs: usize,
+    /// Some failing pose was left unanalysed, with no bound: `capacities`
+    /// is the smallest found, an upper bound of the true smallest.
+    partial: bool,
 }
 
 /// Solver settings.
@@ -867,14 +874,25 @@ impl Analyzer {
             };
             if self.settings.corner_gate && overloaded(r) {
                 j_out.gate = j_out.gate.max(r);
-                // The elastic forces scaled down by `k` keep the centre of
-                // pressure no further out and the clamp at `pL² − N/k`:
-                // the corners carry them from `k = r − (r − 1)·N/pL²`
+                // First scale by `k₀ = max(u, 1)`, which brings the load
+                // within the utilisation (centre of pressure inside the
+                // square); from there the forces scaled down by `k` keep
+                // the centre no further out and the clamp at `pL² − N/k`,
+                // so the corners carry them from `k = r − (r − 1)·N/pL²`
                 // (never for a contact without adhesion, where scaling
                 // changes no ratio).
+                let k0 = u.max(1.0);
+                let scaled = load.scaled(1.0 / k0);
+                let r0 = if k0 > 1.0 {
+                    severity(corner_ratio(&scaled, cap))
+                } else {
+                    r
+                };
                 let p = cap.tension();
-                j_out.scale = j_out.scale.max(if p > 0.0 {
-                    r - (r - 1.0) * load.axial / p
+                j_out.scale = j_out.scale.max(if !overloaded(r0) {
+                    k0
+                } else if p > 0.0 {
+                    k0 * (r0 - (r0 - 1.0) * scaled.axial / p)
                 } else {
                     f64::INFINITY
                 });
@@ -924,6 +942,7 @@ impl Analyzer {
             capacities: f64::INFINITY,
             admissible: 0.0,
             runs: 0,
+            partial: false,
         };
         let part = limit::Part {
             bodies: &comps.bodies[c],
@@ -937,24 +956,30 @@ impl Analyzer {
             out.runs += usize::from(rigid.iterations > 0);
             out.rigid = lowest(out.rigid, rigid.lambda);
         }
-        for (i, &(pose, bound)) in failing.iter().enumerate() {
+        let mut failed = false;
+        for &(pose, bound) in failing {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
+            }
+            if failed {
+                // The step fails already. A pose with a bound is counted at
+                // it: the factor stays a lower bound of the true smallest.
+                // A pose with none (its elastic field no scaling makes
+                // admissible) is left out, at 25 poses a sweep the cost of
+                // a whole analysis per failing step: the factor is then
+                // only the smallest found (`partial`).
+                if bound.is_finite() {
+                    out.capacities = lowest(out.capacities, 1.0 / bound);
+                } else {
+                    out.partial = true;
+                }
+                continue;
             }
             let loads = body_loads(s, pose);
             let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
-            if cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
-                // The step fails here. The poses not analysed are counted
-                // at their bounds: the factor reported is then a lower
-                // bound of the true smallest (1/λ an upper bound), never
-                // more optimistic.
-                if let Some(&(_, next)) = failing.get(i + 1) {
-                    out.capacities = lowest(out.capacities, 1.0 / next);
-                }
-                break;
-            }
+            failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
         out
     }
@@ -1051,6 +1076,7 @@ impl Analyzer {
             // The smallest factor; a failed solve (NaN) sticks.
             let lf = l.capacities;
             out.load_factor = Some(out.load_factor.map_or(lf, |x| lowest(x, lf)));
+            out.load_factor_partial |= l.partial;
             if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.

@@ -31,6 +31,11 @@ pub struct Row {
     pub lattice_violations: usize,
     /// Largest connector utilisation over every step, at the model's `p`.
     pub max_utilisation: f64,
+    /// Some failing step's limit analysis left a pose without a bound
+    /// unanalysed (see `Analysis::load_factor_partial`): the largest
+    /// utilisation is then at least `max_utilisation`.
+    #[serde(default)]
+    pub max_utilisation_at_least: bool,
     pub critical_step: usize,
     pub critical_connector: String,
     /// Some step has no equilibrium whatever the connectors (tips, floats).
@@ -262,6 +267,7 @@ pub fn study_rows(
             steps: schedule.steps.len(),
             lattice_violations: 0,
             max_utilisation: 0.0,
+            max_utilisation_at_least: false,
             critical_step: 0,
             critical_connector: String::new(),
             no_equilibrium: false,
@@ -297,6 +303,7 @@ pub fn study_rows(
             if a.verdict() == Verdict::NoEquilibrium {
                 row.no_equilibrium = true;
             }
+            row.max_utilisation_at_least |= a.load_factor_partial;
             if a.max_utilisation > row.max_utilisation {
                 row.max_utilisation = a.max_utilisation;
                 row.critical_step = step;
@@ -418,10 +425,18 @@ impl Study {
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{:>4} {:>6} {:>9.4} {:>9.4} {:>6} {:>10.2} {:>10.2} {:>10.2} {:>10.2}  step {}: {}",
+                "{:>4} {:>6} {:>9} {:>9.4} {:>6} {:>10.2} {:>10.2} {:>10.2} {:>10.2}  step {}: {}",
                 r.b,
                 r.steps,
-                r.max_utilisation,
+                format!(
+                    "{}{:.4}",
+                    if r.max_utilisation_at_least {
+                        "≥"
+                    } else {
+                        ""
+                    },
+                    r.max_utilisation
+                ),
                 r.closed_utilisation,
                 if r.safe() { "yes" } else { "NO" },
                 r.min_pressure_rigid_hinge / 1e3,
@@ -580,6 +595,31 @@ mod tests {
         // With no schedule at all, the study fails with the first error.
         let none = b_study("branch", &model, &[2, 2], generate, &Reporter::silent());
         assert!(none.unwrap_err().to_string().contains("module 9"));
+    }
+
+    #[test]
+    fn an_overloaded_pyramid_reports_its_load_factor_not_an_unbounded_utilisation() {
+        // At b = 10 the 2-pyramid is overloaded, and some failing poses have
+        // elastic fields the limit analysis's corners cannot carry at any
+        // scaling (no finite bound on 1/λ): those are analysed, not counted
+        // as unbounded. The worst step is a determinate ground-layer
+        // branch: 1/λ equals the closed form of b − 3 = 7 modules and the
+        // agent (as for every b ≥ 5 of this family).
+        let model = Model::default_catom();
+        let generate = family("pyramid", 3.6, None, None).unwrap();
+        let st = b_study("pyramid", &model, &[10], generate, &Reporter::silent()).unwrap();
+        let r = &st.rows[0];
+        let expected = closed_form::cantilever_utilisation(&model, 7, true);
+        assert!(
+            (r.max_utilisation - expected).abs() < 1e-6 * expected,
+            "{} vs {expected}",
+            r.max_utilisation
+        );
+        assert!(!r.safe());
+        // Poses with no bound were left out after the step failed: the
+        // row says its figure is a lower bound, and the table marks it.
+        assert!(r.max_utilisation_at_least);
+        assert!(st.table().contains("≥"), "{}", st.table());
     }
 
     #[test]
