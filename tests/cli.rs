@@ -663,3 +663,56 @@ fn a_random_scenario_names_its_growth_rule() {
         "{err}"
     );
 }
+
+#[test]
+fn plot_figure_12_draws_the_canonical_shapes_beside_the_published_points() {
+    let out = scratch("fig12.png");
+    let table = succeed(
+        bin()
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args([
+                "plot",
+                "--figure",
+                "12",
+                "--sizes",
+                "2..3",
+                "--no-progress",
+                "-o",
+            ])
+            .arg(&out),
+    );
+    // Both protocols of the four shapes at two sizes, the pyramid beside
+    // Eq. 6 and the cube beside the authors' run (their module counts).
+    assert_eq!(table.lines().count(), 1 + 4 * 2 * 2, "{table}");
+    assert!(
+        table.contains("pyramid              2 paper          65") && table.contains("80 ("),
+        "{table}"
+    );
+    assert!(
+        table.contains("243 (") && table.contains("414 ="),
+        "{table}"
+    );
+    let png = std::fs::read(&out).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+}
+
+#[test]
+fn plot_refuses_an_unknown_figure_and_sizes_outside_the_authors_targets() {
+    for args in [
+        vec!["--figure", "10"],
+        vec!["--figure", "11", "--sizes", "1..12"],
+        vec!["--figure", "11", "--sizes", "two"],
+    ] {
+        let o = bin()
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .arg("plot")
+            .args(&args)
+            .arg("-o")
+            .arg(scratch("bad-fig.png"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("--figure") || e.contains("--sizes"), "{e}");
+    }
+}

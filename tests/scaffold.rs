@@ -213,7 +213,7 @@ fn scaffolds_too_large_to_plan_are_refused_before_any_work() {
 
 #[test]
 fn placement_curve_counts_every_module_once() {
-    use reconfcheck::algorithms::scaffold::plot::placed_per_step;
+    use reconfcheck::study::scaffold_figures::placed_per_step;
     let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 2 }, 6).unwrap();
     let v = placed_per_step(&s);
     assert_eq!(v.iter().sum::<usize>(), 65);
@@ -221,7 +221,7 @@ fn placement_curve_counts_every_module_once() {
     #[cfg(feature = "render")]
     {
         let out = std::env::temp_dir().join(format!("scaffold-plot-{}.png", std::process::id()));
-        reconfcheck::render::placed_plot(&[("h2".into(), v)], "pyramid", &out).unwrap();
+        reconfcheck::render::placed_plot(&[("h2".into(), v)], "pyramid", &[], &out).unwrap();
         assert!(std::fs::metadata(&out).unwrap().len() > 1000);
     }
 }

@@ -5,6 +5,8 @@
 
 pub mod b_study;
 pub mod density;
+#[cfg(feature = "render")]
+pub mod figures;
 pub mod interop;
 pub mod parallel;
 #[cfg(feature = "render")]

@@ -43,21 +43,46 @@ pub fn render(a: RenderArgs) -> Result<u8, Error> {
 
 #[derive(clap::Args)]
 pub struct PlotArgs {
-    #[arg(required = true)]
+    /// Scenarios whose placement curves to draw (with `--figure 16`, the
+    /// sandcastles to draw instead of the bundled two).
+    #[arg(required_unless_present = "figure")]
     scenarios: Vec<PathBuf>,
     #[arg(short, long)]
     output: PathBuf,
     /// Chart title.
     #[arg(long, default_value = "scaffold assembly")]
     title: String,
+    /// Draw seed 000's Fig. 11 to 16 (§5.4) instead, with the published
+    /// numbers beside ours (table on stdout; see docs/scaffold.md).
+    #[arg(long, value_name = "N")]
+    figure: Option<u32>,
+    /// Sizes for Figs. 11–13: `A..B` or `A,B,…`, within 2..9.
+    #[arg(long, default_value = "2..9")]
+    sizes: String,
+    /// Folder of the authors' canonical targets.
+    #[arg(long, value_name = "DIR")]
+    shapes: Option<PathBuf>,
+    /// Never show a progress bar.
+    #[arg(long)]
+    no_progress: bool,
 }
 
 pub fn plot(a: PlotArgs) -> Result<u8, Error> {
+    if let Some(number) = a.figure {
+        return super::figures::draw(super::figures::Figure {
+            number,
+            sizes: super::figures::parse_sizes(&a.sizes)?,
+            shapes: super::figures::shapes_dir(a.shapes.as_deref()),
+            scenarios: a.scenarios,
+            output: a.output,
+            progress: !a.no_progress,
+        });
+    }
     let mut curves = Vec::new();
     for p in &a.scenarios {
         let sc = Scenario::load(p)?;
         let s = algorithms::generate(&sc)?;
-        let v = algorithms::scaffold::plot::placed_per_step(&s);
+        let v = reconfcheck::study::scaffold_figures::placed_per_step(&s);
         eprintln!(
             "{}: {} modules placed in {} steps",
             sc.name,
@@ -66,7 +91,7 @@ pub fn plot(a: PlotArgs) -> Result<u8, Error> {
         );
         curves.push((sc.name.clone(), v));
     }
-    render::placed_plot(&curves, &a.title, &a.output)?;
+    render::placed_plot(&curves, &a.title, &[], &a.output)?;
     Ok(0)
 }
 

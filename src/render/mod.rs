@@ -14,6 +14,7 @@ mod catom;
 pub mod density;
 mod loadmap;
 mod placed;
+pub mod scaffold_figures;
 
 pub use b_study::plot as b_study_plot;
 pub use catom::{Picture, svg as catom_svg};

@@ -7,12 +7,23 @@ use std::path::Path;
 
 /// Draws one or more placement curves (label, per-step counts) as a PNG
 /// or SVG: instantaneous placements per step, and the cumulative count.
-pub fn draw(curves: &[(String, Vec<usize>)], title: &str, path: &Path) -> Result<(), Error> {
+/// `marks` are published times (label, step), drawn as dashed verticals
+/// on both charts.
+pub fn draw(
+    curves: &[(String, Vec<usize>)],
+    title: &str,
+    marks: &[(String, f64)],
+    path: &Path,
+) -> Result<(), Error> {
     let svg = crate::render::svg(path, |svg| {
         let root = SvgCanvas::with_string(svg, (900, 420)).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
         let (left, right) = root.split_horizontally(450);
-        let steps = curves.iter().map(|c| c.1.len()).max().unwrap_or(1).max(1);
+        let steps = curves
+            .iter()
+            .map(|c| c.1.len() as f64)
+            .chain(marks.iter().map(|m| m.1 * 1.02))
+            .fold(1.0f64, f64::max);
         let window = 10usize;
         let smooth = |v: &[usize]| -> Vec<(f64, f64)> {
             (0..v.len())
@@ -33,7 +44,7 @@ pub fn draw(curves: &[(String, Vec<usize>)], title: &str, path: &Path) -> Result
             .margin(8)
             .x_label_area_size(30)
             .y_label_area_size(40)
-            .build_cartesian_2d(0.0..steps as f64, 0.0..ymax * 1.1)
+            .build_cartesian_2d(0.0..steps, 0.0..ymax * 1.1)
             .map_err(draw_err)?;
         chart
             .configure_mesh()
@@ -49,6 +60,24 @@ pub fn draw(curves: &[(String, Vec<usize>)], title: &str, path: &Path) -> Result
                 .map_err(draw_err)?
                 .label(label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], col));
+        }
+        for (k, (label, t)) in marks.iter().enumerate() {
+            let col = RGBColor(90, 90, 90);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(*t, 0.0), (*t, ymax * 1.1)],
+                    6,
+                    4,
+                    col.stroke_width(2),
+                ))
+                .map_err(draw_err)?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    label.clone(),
+                    (*t, ymax * (1.05 - 0.07 * k as f64)),
+                    ("sans-serif", 12).into_font().color(&BLACK),
+                )))
+                .map_err(draw_err)?;
         }
         chart
             .configure_series_labels()
@@ -67,7 +96,7 @@ pub fn draw(curves: &[(String, Vec<usize>)], title: &str, path: &Path) -> Result
             .margin(8)
             .x_label_area_size(30)
             .y_label_area_size(50)
-            .build_cartesian_2d(0.0..steps as f64, 0.0..total as f64 * 1.05)
+            .build_cartesian_2d(0.0..steps, 0.0..total as f64 * 1.05)
             .map_err(draw_err)?;
         cum.configure_mesh()
             .x_desc("time step")
@@ -87,6 +116,15 @@ pub fn draw(curves: &[(String, Vec<usize>)], title: &str, path: &Path) -> Result
                 .collect();
             cum.draw_series(LineSeries::new(pts, &col))
                 .map_err(draw_err)?;
+        }
+        for (_, t) in marks {
+            cum.draw_series(DashedLineSeries::new(
+                [(*t, 0.0), (*t, total as f64 * 1.05)],
+                6,
+                4,
+                RGBColor(90, 90, 90).stroke_width(2),
+            ))
+            .map_err(draw_err)?;
         }
         root.present().map_err(draw_err)?;
         Ok(())

@@ -13,7 +13,6 @@
 pub mod csg;
 pub mod paper;
 pub mod planner;
-pub mod plot;
 pub mod polytree;
 #[allow(clippy::module_inception)]
 pub mod scaffold;
@@ -26,11 +25,13 @@ use crate::geometry::MotionRules;
 use crate::lattice::config::{Ground, ModuleId};
 use crate::lattice::{Cell, LatticeKind};
 use crate::scenario::Scenario;
-use crate::schedule::{Length, ModuleSpec, Schedule, Step};
+use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
 use paper::Protocol;
+use rustc_hash::FxHashMap;
 use scaffold::Scaffold;
 use serde::Deserialize;
 use shape::{CubeShape, Pyramid, Shape, Skew};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// A goal shape, as the library API and scenarios name it.
@@ -288,6 +289,39 @@ pub fn schedule_for(
     sched.meta.insert("b".into(), s.b.into());
     sched.meta.insert("protocol".into(), protocol.name().into());
     sched.meta.insert("tiles".into(), s.tiles.len().into());
+    // Seed 000's Eq. 6 times the critical path: the step at which the
+    // first tile root of each tile layer is in place (1-based steps).
+    let mut layer_roots: BTreeMap<i32, Vec<Cell>> = BTreeMap::new();
+    for (root, t) in &s.tiles {
+        layer_roots.entry(t.layer).or_default().push(root.cell());
+    }
+    let arrival: FxHashMap<Cell, usize> = sched
+        .steps
+        .iter()
+        .enumerate()
+        .flat_map(|(k, st)| {
+            st.events.iter().filter_map(move |e| match e {
+                Event::Rotate { to, .. } => Some((*to, k + 1)),
+                _ => None,
+            })
+        })
+        .collect();
+    let root_steps: Vec<usize> = layer_roots
+        .values()
+        .map(|cells| {
+            cells
+                .iter()
+                .filter_map(|c| arrival.get(c).copied())
+                .min()
+                .unwrap_or(0)
+        })
+        .collect();
+    sched
+        .meta
+        .insert("tile_layers".into(), layer_roots.len().into());
+    sched
+        .meta
+        .insert("layer_root_steps".into(), root_steps.into());
     sched.meta.insert("scaffold_modules".into(), n.into());
     sched
         .meta
