@@ -67,12 +67,7 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
             .map_err(draw_err)?
             .label("closed form: branch of b (b − 1 modules + agent)")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RED.stroke_width(1)));
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(draw_err)?;
+        crate::render::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
 
         let pmax = study
             .rows
@@ -153,12 +148,7 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
                     PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(1))
                 });
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(draw_err)?;
+        crate::render::legend(&mut c, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(draw_err)?;
         Ok(())
     })?;

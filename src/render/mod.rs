@@ -26,6 +26,25 @@ pub use placed::draw as placed_plot;
 #[error("{0}")]
 pub struct DrawError(String);
 
+/// Draws a chart's legend at `at`, on a light box with a black border
+/// (every chart here uses the same).
+pub(crate) fn legend<'a, DB, CT>(
+    c: &mut plotters::chart::ChartContext<'a, DB, CT>,
+    at: plotters::chart::SeriesLabelPosition,
+) -> Result<(), DrawError>
+where
+    DB: plotters::prelude::DrawingBackend + 'a,
+    CT: plotters::coord::CoordTranslate,
+{
+    use plotters::style::{BLACK, Color, WHITE};
+    c.configure_series_labels()
+        .position(at)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_err)
+}
+
 /// Any drawing backend's error as a [`DrawError`], for `map_err`.
 pub fn draw_err(e: impl std::fmt::Display) -> DrawError {
     DrawError(e.to_string())

@@ -79,12 +79,7 @@ pub fn draw(
                 )))
                 .map_err(draw_err)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_err)?;
+        crate::render::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         let total = curves
             .iter()
             .map(|c| c.1.iter().sum::<usize>())

@@ -152,12 +152,7 @@ pub fn draw(runs: &[Run], metric: Metric, path: &Path) -> Result<(), Error> {
                     .legend(move |(x, y)| Circle::new((x + 9, y), 6, col.stroke_width(2)));
             }
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(draw_err)?;
+        crate::render::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(draw_err)?;
         Ok(())
     })?;
