@@ -8,6 +8,7 @@
 //! units of the lattice spacing d; z is up. Anything else is refused with
 //! an error naming the line — a shape is never silently approximated.
 
+use super::csg_text::{Cursor, Tok, Tokens, lex};
 use super::shape::{Shape, Skew};
 use crate::error::InputError;
 use glam::DVec3;
@@ -123,13 +124,11 @@ impl CsgShape {
 
     pub fn parse(name: &str, text: &str) -> Result<CsgShape, InputError> {
         let mut p = Parser {
-            toks: lex(text)?,
-            pos: 0,
+            t: Tokens::new(lex(text)?),
             vars: HashMap::new(),
-            depth: 0,
         };
         let mut nodes = Vec::new();
-        while p.pos < p.toks.len() {
+        while !p.t.at_end() {
             if let Some(n) = p.statement()? {
                 nodes.push(n);
             }
@@ -175,59 +174,6 @@ impl CsgShape {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
-enum Tok {
-    Num(f64),
-    Id(String),
-    Sym(char),
-}
-
-fn lex(text: &str) -> Result<Vec<(Tok, usize, usize)>, InputError> {
-    let mut out = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let line_no = ln + 1;
-        let line = line.split("//").next().unwrap_or("");
-        let cs: Vec<char> = line.chars().collect();
-        let mut i = 0;
-        while i < cs.len() {
-            let c = cs[i];
-            if c.is_whitespace() {
-                i += 1;
-            } else if c.is_ascii_digit()
-                || (c == '.' && cs.get(i + 1).is_some_and(|d| d.is_ascii_digit()))
-            {
-                let s = i;
-                while i < cs.len() && (cs[i].is_ascii_digit() || cs[i] == '.' || cs[i] == 'e') {
-                    i += 1;
-                }
-                let t: String = cs[s..i].iter().collect();
-                let v = t.parse().map_err(|_| {
-                    InputError::new(format!(
-                        "line {line_no}, column {}: bad number '{t}'",
-                        s + 1
-                    ))
-                })?;
-                out.push((Tok::Num(v), line_no, s + 1));
-            } else if c.is_alphabetic() || c == '_' || c == '$' {
-                let s = i;
-                while i < cs.len() && (cs[i].is_alphanumeric() || cs[i] == '_' || cs[i] == '$') {
-                    i += 1;
-                }
-                out.push((Tok::Id(cs[s..i].iter().collect()), line_no, s + 1));
-            } else if "()[]{},;=+-*/".contains(c) {
-                out.push((Tok::Sym(c), line_no, i + 1));
-                i += 1;
-            } else {
-                return Err(InputError::new(format!(
-                    "line {line_no}, column {}: unexpected character '{c}'",
-                    i + 1
-                )));
-            }
-        }
-    }
-    Ok(out)
-}
-
 #[derive(Clone, Debug)]
 enum Val {
     Num(f64),
@@ -236,11 +182,10 @@ enum Val {
 }
 
 struct Parser {
-    toks: Vec<(Tok, usize, usize)>,
-    pos: usize,
+    /// Tokens, position, and nesting of objects and parentheses (see
+    /// [`MAX_DEPTH`]).
+    t: Tokens,
     vars: HashMap<String, f64>,
-    /// Current nesting of objects and parentheses (see [`MAX_DEPTH`]).
-    depth: usize,
 }
 
 /// Deepest nesting of objects or parenthesised expressions read: the
@@ -250,58 +195,34 @@ struct Parser {
 /// near 100 levels.
 pub const MAX_DEPTH: usize = 100;
 
-impl Parser {
+impl Cursor for Parser {
+    fn tokens(&self) -> &Tokens {
+        &self.t
+    }
+    fn tokens_mut(&mut self) -> &mut Tokens {
+        &mut self.t
+    }
+    fn max_depth(&self) -> usize {
+        MAX_DEPTH
+    }
     fn err(&self, msg: impl std::fmt::Display) -> InputError {
-        let (line, col) = self
-            .toks
-            .get(self.pos)
-            .or(self.toks.last())
-            .map(|t| (t.1, t.2))
-            .unwrap_or((0, 0));
+        let (line, col) = self.here().unwrap_or((0, 0));
         InputError::new(format!("line {line}, column {col}: {msg}"))
     }
-    /// Enters one nesting level, refusing beyond [`MAX_DEPTH`].
-    fn deeper(&mut self) -> Result<(), InputError> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
-            return Err(self.err(format!("nested more than {MAX_DEPTH} levels deep")));
-        }
-        Ok(())
+    fn constant(&self, name: &str) -> Option<f64> {
+        self.vars.get(name).copied()
     }
-    fn peek(&self) -> Option<&Tok> {
-        self.toks.get(self.pos).map(|t| &t.0)
-    }
-    fn next(&mut self) -> Option<Tok> {
-        let t = self.toks.get(self.pos).map(|t| t.0.clone());
-        self.pos += 1;
-        t
-    }
-    fn expect(&mut self, c: char) -> Result<(), InputError> {
-        match self.next() {
-            Some(Tok::Sym(s)) if s == c => Ok(()),
-            other => {
-                self.pos -= 1;
-                Err(self.err(format!("expected '{c}', found {other:?}")))
-            }
-        }
-    }
-    fn eat(&mut self, c: char) -> bool {
-        if self.peek() == Some(&Tok::Sym(c)) {
-            self.pos += 1;
-            true
-        } else {
-            false
-        }
-    }
+}
 
+impl Parser {
     fn statement(&mut self) -> Result<Option<Node>, InputError> {
         if self.eat(';') {
             return Ok(None);
         }
         if let (Some(Tok::Id(name)), Some((Tok::Sym('='), _, _))) =
-            (self.peek().cloned(), self.toks.get(self.pos + 1))
+            (self.peek().cloned(), self.t.toks.get(self.t.pos + 1))
         {
-            self.pos += 2;
+            self.t.pos += 2;
             let v = self.expr()?;
             self.expect(';')?;
             self.vars.insert(name, v);
@@ -313,13 +234,13 @@ impl Parser {
     fn object(&mut self) -> Result<Node, InputError> {
         self.deeper()?;
         let node = self.object_inner();
-        self.depth -= 1;
+        self.t.depth -= 1;
         node
     }
 
     fn object_inner(&mut self) -> Result<Node, InputError> {
-        let Some(Tok::Id(name)) = self.next() else {
-            self.pos -= 1;
+        let Some(Tok::Id(name)) = self.next_tok() else {
+            self.t.pos -= 1;
             return Err(self.err("expected a CSG object"));
         };
         let args = self.checked_args(&name)?;
@@ -410,9 +331,9 @@ impl Parser {
             _ => return Ok(args.into_iter().map(|(n, v, _)| (n, v)).collect()),
         };
         let mut seen = 0;
-        let end = self.pos;
+        let end = self.t.pos;
         for (n, v, at) in &args {
-            self.pos = *at;
+            self.t.pos = *at;
             match n {
                 None if matches!(v, Val::Bool(_)) => {
                     return Err(self.err(format!(
@@ -451,7 +372,7 @@ impl Parser {
                 Some(_) => {}
             }
         }
-        self.pos = end;
+        self.t.pos = end;
         Ok(args.into_iter().map(|(n, v, _)| (n, v)).collect())
     }
 
@@ -490,10 +411,10 @@ impl Parser {
             return Ok(out);
         }
         loop {
-            let start = self.pos;
-            let name = match (self.peek().cloned(), self.toks.get(self.pos + 1)) {
+            let start = self.t.pos;
+            let name = match (self.peek().cloned(), self.t.toks.get(self.t.pos + 1)) {
                 (Some(Tok::Id(n)), Some((Tok::Sym('='), _, _))) => {
-                    self.pos += 2;
+                    self.t.pos += 2;
                     Some(n)
                 }
                 _ => None,
@@ -507,10 +428,10 @@ impl Parser {
                 self.expect(']')?;
                 Val::Vec3(DVec3::new(x, y, z))
             } else if self.peek() == Some(&Tok::Id("true".into())) {
-                self.pos += 1;
+                self.t.pos += 1;
                 Val::Bool(true)
             } else if self.peek() == Some(&Tok::Id("false".into())) {
-                self.pos += 1;
+                self.t.pos += 1;
                 Val::Bool(false)
             } else {
                 Val::Num(self.expr()?)
@@ -520,63 +441,6 @@ impl Parser {
                 return Ok(out);
             }
             self.expect(',')?;
-        }
-    }
-
-    fn expr(&mut self) -> Result<f64, InputError> {
-        let mut v = self.term()?;
-        loop {
-            if self.eat('+') {
-                v += self.term()?;
-            } else if self.eat('-') {
-                v -= self.term()?;
-            } else {
-                return Ok(v);
-            }
-        }
-    }
-    fn term(&mut self) -> Result<f64, InputError> {
-        let mut v = self.factor()?;
-        loop {
-            if self.eat('*') {
-                v *= self.factor()?;
-            } else if self.eat('/') {
-                v /= self.factor()?;
-            } else {
-                return Ok(v);
-            }
-        }
-    }
-    fn factor(&mut self) -> Result<f64, InputError> {
-        match self.next() {
-            Some(Tok::Num(v)) => Ok(v),
-            Some(Tok::Sym('-')) => {
-                self.deeper()?;
-                let v = self.factor();
-                self.depth -= 1;
-                Ok(-v?)
-            }
-            Some(Tok::Sym('(')) => {
-                self.deeper()?;
-                let v = self.expr()?;
-                self.depth -= 1;
-                self.expect(')')?;
-                Ok(v)
-            }
-            Some(Tok::Id(f)) if f == "sqrt" => {
-                self.expect('(')?;
-                let v = self.expr()?;
-                self.expect(')')?;
-                Ok(v.sqrt())
-            }
-            Some(Tok::Id(n)) => self.vars.get(&n).copied().ok_or_else(|| {
-                self.pos -= 1;
-                self.err(format!("unknown name '{n}'"))
-            }),
-            other => {
-                self.pos -= 1;
-                Err(self.err(format!("expected a number, found {other:?}")))
-            }
         }
     }
 }

@@ -11,6 +11,7 @@
 //! See `docs/scaffold.md`.
 
 pub mod csg;
+mod csg_text;
 pub mod paper;
 pub mod planner;
 pub mod polytree;

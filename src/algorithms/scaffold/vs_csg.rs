@@ -31,6 +31,7 @@
 //! Not read (refused with line and column): a one-number `cube(s)`
 //! (VisibleSim reads it as a degenerate cube), and anything else.
 
+use super::csg_text::{Cursor, Tok, Tokens, lex};
 use super::shape::{Shape, Skew};
 use crate::error::InputError;
 use glam::DVec3;
@@ -151,62 +152,8 @@ impl VsNode {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
-enum Tok {
-    Num(f64),
-    Id(String),
-    Sym(char),
-}
-
-fn lex(text: &str) -> Result<Vec<(Tok, usize, usize)>, InputError> {
-    let mut out = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let cs: Vec<char> = line.split("//").next().unwrap_or("").chars().collect();
-        let mut i = 0;
-        while i < cs.len() {
-            let c = cs[i];
-            let at = (ln + 1, i + 1);
-            if c.is_whitespace() {
-                i += 1;
-            } else if c.is_ascii_digit() || c == '.' {
-                let s = i;
-                while i < cs.len()
-                    && (cs[i].is_ascii_digit()
-                        || cs[i] == '.'
-                        || cs[i] == 'e'
-                        || ((cs[i] == '-' || cs[i] == '+') && i > s && cs[i - 1] == 'e'))
-                {
-                    i += 1;
-                }
-                let t: String = cs[s..i].iter().collect();
-                let v: f64 = t.parse().map_err(|_| {
-                    InputError::new(format!("line {}, column {}: bad number '{t}'", at.0, at.1))
-                })?;
-                out.push((Tok::Num(v), at.0, at.1));
-            } else if c.is_alphabetic() || c == '_' || c == '$' {
-                let s = i;
-                while i < cs.len() && (cs[i].is_alphanumeric() || cs[i] == '_' || cs[i] == '$') {
-                    i += 1;
-                }
-                out.push((Tok::Id(cs[s..i].iter().collect()), at.0, at.1));
-            } else if "()[]{},;=+-*/".contains(c) {
-                out.push((Tok::Sym(c), at.0, at.1));
-                i += 1;
-            } else {
-                return Err(InputError::new(format!(
-                    "line {}, column {}: unexpected character '{c}'",
-                    at.0, at.1
-                )));
-            }
-        }
-    }
-    Ok(out)
-}
-
 struct Parser {
-    toks: Vec<(Tok, usize, usize)>,
-    pos: usize,
-    depth: usize,
+    t: Tokens,
     /// Line offset of the CSG text in its file (the `<csg>` element's line).
     line0: usize,
 }
@@ -218,58 +165,39 @@ enum Arg {
     Flag,
 }
 
-impl Parser {
+impl Cursor for Parser {
+    fn tokens(&self) -> &Tokens {
+        &self.t
+    }
+    fn tokens_mut(&mut self) -> &mut Tokens {
+        &mut self.t
+    }
+    fn max_depth(&self) -> usize {
+        MAX_VS_DEPTH
+    }
     fn err(&self, msg: impl std::fmt::Display) -> InputError {
-        let (l, c) = self
-            .toks
-            .get(self.pos)
-            .or(self.toks.last())
-            .map(|t| (t.1, t.2))
-            .unwrap_or((1, 0));
+        let (l, c) = self.here().unwrap_or((1, 0));
         InputError::new(format!(
             "CSG line {}, column {c}: {msg}",
             l + self.line0.saturating_sub(1)
         ))
     }
-    fn peek(&self) -> Option<&Tok> {
-        self.toks.get(self.pos).map(|t| &t.0)
-    }
-    fn eat(&mut self, c: char) -> bool {
-        if self.peek() == Some(&Tok::Sym(c)) {
-            self.pos += 1;
-            true
-        } else {
-            false
-        }
-    }
-    fn expect(&mut self, c: char) -> Result<(), InputError> {
-        if self.eat(c) {
-            Ok(())
-        } else {
-            Err(self.err(format!("expected '{c}'")))
-        }
-    }
-    fn deeper(&mut self) -> Result<(), InputError> {
-        self.depth += 1;
-        if self.depth > MAX_VS_DEPTH {
-            return Err(self.err(format!("nested more than {MAX_VS_DEPTH} levels deep")));
-        }
-        Ok(())
-    }
+}
 
+impl Parser {
     fn object(&mut self) -> Result<VsNode, InputError> {
         self.deeper()?;
         let n = self.object_inner();
-        self.depth -= 1;
+        self.t.depth -= 1;
         n
     }
 
     fn object_inner(&mut self) -> Result<VsNode, InputError> {
-        let start = self.pos;
+        let start = self.t.pos;
         let Some(Tok::Id(name)) = self.peek().cloned() else {
             return Err(self.err("expected a CSG object"));
         };
-        self.pos += 1;
+        self.t.pos += 1;
         let args = self.args()?;
         // Parameters as VisibleSim stores them: float32.
         let nums: Vec<f64> = args
@@ -282,7 +210,7 @@ impl Parser {
             .map(|v| v as f32 as f64)
             .collect();
         let at_start = |p: &mut Parser, msg: String| {
-            p.pos = start;
+            p.t.pos = start;
             p.err(msg)
         };
         let three = |p: &mut Parser, nums: &[f64]| -> Result<DVec3, InputError> {
@@ -404,12 +332,12 @@ impl Parser {
         loop {
             // `center = true`: VisibleSim ignores named flags too.
             if let (Some(Tok::Id(_)), Some((Tok::Sym('='), _, _))) =
-                (self.peek().cloned(), self.toks.get(self.pos + 1))
+                (self.peek().cloned(), self.t.toks.get(self.t.pos + 1))
             {
-                self.pos += 2;
+                self.t.pos += 2;
             }
             let a = if matches!(self.peek(), Some(Tok::Id(s)) if s == "true" || s == "false") {
-                self.pos += 1;
+                self.t.pos += 1;
                 Arg::Flag
             } else if self.eat('[') {
                 let mut v = vec![self.expr()?];
@@ -428,86 +356,19 @@ impl Parser {
             self.expect(',')?;
         }
     }
-
-    fn expr(&mut self) -> Result<f64, InputError> {
-        let mut v = self.term()?;
-        loop {
-            if self.eat('+') {
-                v += self.term()?;
-            } else if self.eat('-') {
-                v -= self.term()?;
-            } else {
-                return Ok(v);
-            }
-        }
-    }
-    fn term(&mut self) -> Result<f64, InputError> {
-        let mut v = self.factor()?;
-        loop {
-            if self.eat('*') {
-                v *= self.factor()?;
-            } else if self.eat('/') {
-                v /= self.factor()?;
-            } else {
-                return Ok(v);
-            }
-        }
-    }
-    fn factor(&mut self) -> Result<f64, InputError> {
-        self.deeper()?;
-        let v = self.factor_inner();
-        self.depth -= 1;
-        let v = v?;
-        if !v.is_finite() {
-            return Err(self.err("the expression is not a finite number"));
-        }
-        Ok(v)
-    }
-    fn factor_inner(&mut self) -> Result<f64, InputError> {
-        match self.peek().cloned() {
-            Some(Tok::Num(v)) => {
-                self.pos += 1;
-                Ok(v)
-            }
-            Some(Tok::Sym('-')) => {
-                self.pos += 1;
-                Ok(-self.factor()?)
-            }
-            Some(Tok::Sym('+')) => {
-                self.pos += 1;
-                self.factor()
-            }
-            Some(Tok::Sym('(')) => {
-                self.pos += 1;
-                let v = self.expr()?;
-                self.expect(')')?;
-                Ok(v)
-            }
-            Some(Tok::Id(f)) if f == "sqrt" => {
-                self.pos += 1;
-                self.expect('(')?;
-                let v = self.expr()?;
-                self.expect(')')?;
-                Ok(v.sqrt())
-            }
-            _ => Err(self.err("expected a number")),
-        }
-    }
 }
 
 /// Parses the `content` of a `<csg>` target. `line0` is the line of the
 /// `<csg>` element in its file, so that errors name the file's line.
 pub fn parse_vs_csg(text: &str, line0: usize) -> Result<VsNode, InputError> {
     let mut p = Parser {
-        toks: lex(text).map_err(|e| {
+        t: Tokens::new(lex(text).map_err(|e| {
             InputError::new(format!("CSG (starting at line {line0}): {}", e.message))
-        })?,
-        pos: 0,
-        depth: 0,
+        })?),
         line0,
     };
     let mut nodes = Vec::new();
-    while p.pos < p.toks.len() {
+    while !p.t.at_end() {
         if p.eat(';') {
             continue;
         }
@@ -520,7 +381,7 @@ pub fn parse_vs_csg(text: &str, line0: usize) -> Result<VsNode, InputError> {
         1 => Ok(nodes.pop().expect("one node")),
         // VisibleSim keeps only the first top-level object.
         _ => {
-            p.pos = 0;
+            p.t.pos = 0;
             Err(InputError::new(format!(
                 "the <csg> target at line {line0} has {} top-level objects; VisibleSim reads only \
                  the first: wrap them in union() {{ … }}",
