@@ -53,6 +53,7 @@ fn sweep_checks(c: &mut Criterion) {
                 let input = SweepInput {
                     lattice: &FccLattice,
                     config: &config,
+                    ground: None,
                     moves: &moves,
                     moving: &moving,
                     epsilon: reconfcheck::geometry::Tolerance::DEFAULT,
