@@ -384,7 +384,8 @@ impl World {
                             to: *cell,
                             pivot: pivot_cell.unwrap_or(*from),
                             route: route.ok_or_else(|| {
-                                err("a docking on the FCC lattice needs its rotation's route".into())
+                                err("a docking on the FCC lattice needs its rotation's route"
+                                    .into())
                             })?,
                         },
                         _ => Motion::Slide {

@@ -22,7 +22,9 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<u8, Error> {
     if a.seeds == 0 || !(a.factor.is_finite() && a.factor > 0.0) {
-        return Err(InputError::new("docking-study needs --seeds ≥ 1 and a positive --factor").into());
+        return Err(
+            InputError::new("docking-study needs --seeds ≥ 1 and a positive --factor").into(),
+        );
     }
     let messages = study::messages(&a.models, a.seeds)?;
     let curves = study::availability(&a.models, a.factor, a.seeds)?;

@@ -37,7 +37,12 @@ pub fn candidates(lattice: &dyn Lattice, cell: Cell) -> Vec<Approach> {
     if lattice.kind() != LatticeKind::Square {
         return out;
     }
-    let axes = [Cell::xy(1, 0), Cell::xy(0, 1), Cell::xy(-1, 0), Cell::xy(0, -1)];
+    let axes = [
+        Cell::xy(1, 0),
+        Cell::xy(0, 1),
+        Cell::xy(-1, 0),
+        Cell::xy(0, -1),
+    ];
     for d in axes {
         // Straight slide from the side neighbour `cell + d`, along a wall
         // on either side perpendicular to d.
@@ -123,7 +128,11 @@ pub fn judge(
     // check independent of the structure's size.
     let mut scene = Configuration::new();
     let f = approach.from;
-    let dz = if lattice.kind() == LatticeKind::Square { 0 } else { REACH };
+    let dz = if lattice.kind() == LatticeKind::Square {
+        0
+    } else {
+        REACH
+    };
     for dx in -REACH..=REACH {
         for dy in -REACH..=REACH {
             for dz in -dz..=dz {
@@ -150,10 +159,7 @@ pub fn judge(
         exact: true,
     };
     let contacts: Vec<Contact> = model.check_step(&input);
-    for c in contacts
-        .iter()
-        .filter(|c| c.kind == ContactKind::Collision)
-    {
+    for c in contacts.iter().filter(|c| c.kind == ContactKind::Collision) {
         if let Some(cell) = config.cell_of(c.other)
             && !out.blocking.contains(&cell)
         {

@@ -69,7 +69,8 @@ pub fn messages(models: &Path, seeds: u64) -> Result<Vec<MessageRow>, InputError
                 .map(|s| planner::run(&g, start, s, &Delays::default()))
                 .collect();
             let k = runs.len() as f64;
-            let mean = |f: &dyn Fn(&planner::Run) -> u64| runs.iter().map(f).sum::<u64>() as f64 / k;
+            let mean =
+                |f: &dyn Fn(&planner::Run) -> u64| runs.iter().map(f).sum::<u64>() as f64 / k;
             let messages = mean(&|r| r.messages.total());
             Ok(MessageRow {
                 shape: SHAPES[i].0.to_string(),
@@ -181,18 +182,23 @@ pub fn naive_orders(models: &Path, factor: f64, seed: u64) -> Result<Vec<NaiveRo
 }
 
 /// The three tables as text.
-pub fn tables(
-    messages: &[MessageRow],
-    curves: &[AvailabilityCurve],
-    naive: &[NaiveRow],
-) -> String {
+pub fn tables(messages: &[MessageRow], curves: &[AvailabilityCurve], naive: &[NaiveRow]) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let _ = writeln!(s, "Fig. 10 — messages against modules (mean over seeds)");
     let _ = writeln!(
         s,
         "{:<14} {:>6} {:>7} {:>10} {:>9} {:>10} {:>8} {:>7} {:>6} {:>8}",
-        "shape", "scale", "n", "messages", "initial", "permission", "sync", "msg/n", "R1", "unfilled"
+        "shape",
+        "scale",
+        "n",
+        "messages",
+        "initial",
+        "permission",
+        "sync",
+        "msg/n",
+        "R1",
+        "unfilled"
     );
     for r in messages {
         let _ = writeln!(

@@ -96,7 +96,10 @@ impl Goal {
         let (lo, hi) = shape.root.bounds();
         let (lo, hi) = (lo * scale, hi * scale);
         let lim = (crate::schedule::MAX_COORDINATE - MARGIN) as f64;
-        if [lo.x, lo.y, hi.x, hi.y].iter().any(|v| !v.is_finite() || v.abs() > lim) {
+        if [lo.x, lo.y, hi.x, hi.y]
+            .iter()
+            .any(|v| !v.is_finite() || v.abs() > lim)
+        {
             return Err(InputError::new(format!(
                 "goal '{}' lies off the lattice: its extent [{}, {}] × [{}, {}] passes ±{lim}",
                 shape.name, lo.x, hi.x, lo.y, hi.y
@@ -295,7 +298,10 @@ mod tests {
         let g = Goal::from_cells("ring", &ring).unwrap();
         let holes = g.internal_holes();
         assert!(holes[g.slot(2, 2).unwrap()]);
-        let c: Vec<_> = ring.into_iter().filter(|&(x, y)| !(x == 2 && y == 3) && !(x == 2 && y == 4)).collect();
+        let c: Vec<_> = ring
+            .into_iter()
+            .filter(|&(x, y)| !(x == 2 && y == 3) && !(x == 2 && y == 4))
+            .collect();
         let g = Goal::from_cells("c", &c).unwrap();
         assert!(g.internal_holes().iter().all(|h| !h));
     }

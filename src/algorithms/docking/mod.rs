@@ -145,12 +145,15 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
                 route: None,
             }],
         });
-        config.insert(id, cell).expect("the planner docks a cell once");
+        config
+            .insert(id, cell)
+            .expect("the planner docks a cell once");
     }
     s.meta.insert("algorithm".into(), "docking".into());
     s.meta.insert("goal".into(), goal.name.clone().into());
     s.meta.insert("modules".into(), goal.len().into());
-    s.meta.insert("messages".into(), run.messages.total().into());
+    s.meta
+        .insert("messages".into(), run.messages.total().into());
     s.meta
         .insert("rule1_violations".into(), run.rule1_violations.into());
     s.meta.insert("unfilled".into(), run.unfilled.into());

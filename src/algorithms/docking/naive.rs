@@ -56,7 +56,13 @@ pub fn run(goal: &Goal, seed_cell: (i32, i32), order: Order, seed: u64) -> Naive
 }
 
 /// One growth: returns (Rule 1 violations, cells filled).
-fn grow(goal: &Goal, seed_cell: (i32, i32), order: Order, seed: u64, refuse: bool) -> (usize, usize) {
+fn grow(
+    goal: &Goal,
+    seed_cell: (i32, i32),
+    order: Order,
+    seed: u64,
+    refuse: bool,
+) -> (usize, usize) {
     let slot = |x: i32, y: i32| goal.slot(x, y);
     let mut filled = vec![false; goal.slots()];
     let mut queued = vec![false; goal.slots()];

@@ -106,21 +106,22 @@ pub struct Run {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Ev {
     Dock { slot: usize, by: usize },
-    Grant { module: usize, target: usize },
+    Attract { slot: usize, by: usize },
 }
 
 const NO: usize = usize::MAX;
 
 struct Sim<'a> {
     g: &'a Goal,
-    w: i32,
-    holes: Vec<bool>,
     filled: Vec<bool>,
-    attracted: Vec<bool>,
-    /// Permission asked for (module slot, target slot).
-    asked: FxHashMap<(usize, usize), ()>,
-    /// Modules waiting for a corner cell: corner → (module, target, hops).
-    waiting: FxHashMap<usize, Vec<(usize, usize, u64)>>,
+    /// Attracted (possibly still waiting for a permission) or docked.
+    taken: Vec<bool>,
+    /// Row-run and column-run of each goal slot, and how many of each
+    /// run's cells are taken.
+    row_of: Vec<usize>,
+    col_of: Vec<usize>,
+    row_taken: Vec<usize>,
+    col_taken: Vec<usize>,
     heap: BinaryHeap<Reverse<(u64, u64, Ev)>>,
     seq: u64,
     now: u64,
@@ -128,6 +129,30 @@ struct Sim<'a> {
     delays: Delays,
     pending: usize,
     run: Run,
+}
+
+/// Labels the maximal runs of goal cells along `(dx, dy)`.
+fn runs(g: &Goal, dx: i32, dy: i32) -> (Vec<usize>, usize) {
+    let mut label = vec![NO; g.slots()];
+    let mut n = 0;
+    for (x, y) in g.cells() {
+        let k = g.slot(x, y).expect("goal cell");
+        if label[k] != NO {
+            continue;
+        }
+        let (mut a, mut b) = (x, y);
+        while g.contains(a - dx, b - dy) {
+            a -= dx;
+            b -= dy;
+        }
+        while g.contains(a, b) {
+            label[g.slot(a, b).expect("goal cell")] = n;
+            a += dx;
+            b += dy;
+        }
+        n += 1;
+    }
+    (label, n)
 }
 
 impl Sim<'_> {
@@ -149,42 +174,6 @@ impl Sim<'_> {
     }
     fn delay(&mut self, range: (u64, u64)) -> u64 {
         self.rng.random_range(range.0..=range.1.max(range.0))
-    }
-
-    /// Sends an attraction signal to a goal cell next to `by`.
-    fn attract(&mut self, x: i32, y: i32, by: usize) {
-        let k = self.slot(x, y);
-        if k == NO || !self.in_goal(x, y) || self.filled[k] || self.attracted[k] {
-            return;
-        }
-        self.attracted[k] = true;
-        self.pending += 1;
-        let t = self.now + self.delay(self.delays.dock);
-        self.push(t, Ev::Dock { slot: k, by });
-    }
-
-    /// Rule 4 (north) or, mirrored, Rule 5 (south): the row, beyond the
-    /// module in direction `dx`, passes a gap under (over) row `y + dy` and
-    /// continues; `Some(gap cell)` when so.
-    fn merge(&self, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i32)> {
-        let mut j = 1;
-        while !self.in_goal(x + j * dx, y) && self.in_goal(x + j * dx, y + dy) {
-            j += 1;
-        }
-        (j > 1 && self.in_goal(x + j * dx, y) && self.in_goal(x + j * dx, y + dy))
-            .then_some((x + dx, y))
-    }
-
-    fn internal(&self, c: (i32, i32)) -> bool {
-        self.g.slot(c.0, c.1).is_some_and(|k| self.holes[k])
-    }
-
-    /// Rule 2 (dy = 1, dx = 1) or Rule 3 (dy = −1, dx = −1), with the
-    /// merge exception of Rules 4–5 for internal holes.
-    fn is_seed(&self, x: i32, y: i32, dx: i32, dy: i32) -> bool {
-        self.in_goal(x, y + dy)
-            && (!self.in_goal(x + dx, y + dy) || !self.in_goal(x + dx, y))
-            && !self.merge(x, y, dx, dy).is_some_and(|gap| self.internal(gap))
     }
 
     /// Hops of a border-following message from `from` to `to` that avoids
@@ -211,86 +200,76 @@ impl Sim<'_> {
         None
     }
 
-    /// Algorithm 2's west (dx = −1, corner below) or east (dx = 1, corner
-    /// above) attraction of module `k`.
-    fn side(&mut self, k: usize, dx: i32) {
-        let (x, y) = self.xy(k);
-        let dy = -dx; // west waits for south-west, east for north-east
-        let t = (x + dx, y);
-        let ts = self.slot(t.0, t.1);
-        if !self.in_goal(t.0, t.1) || self.filled[ts] || self.attracted[ts] {
-            return;
+    /// Whether module `by` may attract the free goal cell `c` next to it,
+    /// and if so the messages that permission costs: the row condition
+    /// (one contiguous line per row: Rules 2–5) and the column condition
+    /// (the corner rule of Fig. 6 / Algorithm 2) must both hold.
+    fn permission(&mut self, c: usize, by: usize) -> Option<(u64, u64)> {
+        let (x, y) = self.xy(c);
+        let (bx, by_y) = self.xy(by);
+        let horizontal = by_y == y;
+        let row_ok = self.is_filled(x - 1, y) || self.is_filled(x + 1, y);
+        let col_ok = self.is_filled(x, y - 1) || self.is_filled(x, y + 1);
+        let row_free = self.row_taken[self.row_of[c]] == 0;
+        let col_free = self.col_taken[self.col_of[c]] == 0;
+        if !(row_ok || row_free) || !(col_ok || col_free) {
+            return None;
         }
-        if self.asked.contains_key(&(k, ts)) {
-            return;
+        // Messages: the condition across the move's direction is learnt
+        // from the cell diagonal to `by` (the corner). A neighbour of `by`
+        // relays it (one reply); across a hole or concavity border
+        // following does (two per hop). A run still empty needs none: the
+        // seed rules decide from the shape alone.
+        let across_ok = if horizontal { col_ok } else { row_ok };
+        if !across_ok {
+            return Some((0, 0));
         }
-        let corner = (x + dx, y + dy);
-        if !self.in_goal(corner.0, corner.1) {
-            self.attract(t.0, t.1, k);
-            return;
-        }
-        let cs = self.slot(corner.0, corner.1);
-        let via = (x, y + dy);
-        if self.is_filled(via.0, via.1) {
-            // Ask the neighbour on the corner's side; it replies once the
-            // corner is in place (one counted message).
-            self.asked.insert((k, ts), ());
-            self.wait_or_grant(cs, k, ts, 1, false);
-        } else if !self.in_goal(via.0, via.1) {
-            // On a hole or concavity border: border following.
-            match self.border_hops(k, cs, ts) {
-                Some(h) => {
-                    self.asked.insert((k, ts), ());
-                    self.wait_or_grant(cs, k, ts, h, true);
-                }
-                // The corner is reachable only through the target: no
-                // order can put it first.
-                None => self.attract(t.0, t.1, k),
-            }
+        // The corner: the filled cell across, next to c.
+        let corners: Vec<(i32, i32)> = if horizontal {
+            vec![(x, y - 1), (x, y + 1)]
         } else {
-            // The corner's side neighbour is still to come: attract it.
-            self.attract(via.0, via.1, k);
+            vec![(x - 1, y), (x + 1, y)]
+        };
+        let corner = corners
+            .into_iter()
+            .find(|&(a, b)| self.is_filled(a, b))
+            .expect("across_ok");
+        // The relay: by's neighbour next to the corner.
+        let relay = (bx + corner.0 - x, by_y + corner.1 - y);
+        if self.is_filled(relay.0, relay.1) {
+            Some((1, 0))
+        } else {
+            let cs = self.slot(corner.0, corner.1);
+            let hops = self.border_hops(by, cs, c).unwrap_or(1);
+            Some((0, 2 * hops))
         }
     }
 
-    fn wait_or_grant(&mut self, corner: usize, module: usize, target: usize, hops: u64, sync: bool) {
-        let hops_code = if sync { hops | (1 << 62) } else { hops };
-        if self.filled[corner] {
-            self.grant_after(module, target, hops_code);
-        } else {
-            self.waiting
-                .entry(corner)
-                .or_default()
-                .push((module, target, hops_code));
-        }
-    }
-
-    fn grant_after(&mut self, module: usize, target: usize, code: u64) {
-        let sync = code & (1 << 62) != 0;
-        let hops = code & !(1 << 62);
-        if sync {
-            self.run.messages.sync += 2 * hops;
-        } else {
-            self.run.messages.permission += 1;
-        }
-        let mut t = self.now;
-        for _ in 0..hops.max(1) {
-            t += self.delay(self.delays.message);
-        }
-        self.push(t, Ev::Grant { module, target });
-    }
-
-    /// Everything module `k` may attract now.
+    /// Tries every free goal neighbour of the module at `k`.
     fn evaluate(&mut self, k: usize) {
         let (x, y) = self.xy(k);
-        if self.is_seed(x, y, 1, 1) {
-            self.attract(x, y + 1, k);
+        for (a, b) in [(x + 1, y), (x, y + 1), (x - 1, y), (x, y - 1)] {
+            if !self.in_goal(a, b) {
+                continue;
+            }
+            let c = self.slot(a, b);
+            if self.taken[c] {
+                continue;
+            }
+            if let Some((perm, sync)) = self.permission(c, k) {
+                self.taken[c] = true;
+                self.row_taken[self.row_of[c]] += 1;
+                self.col_taken[self.col_of[c]] += 1;
+                self.run.messages.permission += perm;
+                self.run.messages.sync += sync;
+                let hops = perm + sync / 2;
+                let mut t = self.now;
+                for _ in 0..hops {
+                    t += self.delay(self.delays.message);
+                }
+                self.push(t, Ev::Attract { slot: c, by: k });
+            }
         }
-        if self.is_seed(x, y, -1, -1) {
-            self.attract(x, y - 1, k);
-        }
-        self.side(k, -1);
-        self.side(k, 1);
     }
 
     fn dock(&mut self, k: usize, by: Option<usize>) {
@@ -323,24 +302,21 @@ impl Sim<'_> {
                 self.evaluate(n);
             }
         }
-        if let Some(list) = self.waiting.remove(&k) {
-            for (m, t, code) in list {
-                self.grant_after(m, t, code);
-            }
-        }
     }
 }
 
 /// Runs the planner on `goal` from `seed_cell` with RNG seed `seed`.
 pub fn run(goal: &Goal, seed_cell: (i32, i32), seed: u64, delays: &Delays) -> Run {
+    let (row_of, rows) = runs(goal, 1, 0);
+    let (col_of, cols) = runs(goal, 0, 1);
     let mut sim = Sim {
         g: goal,
-        w: goal.frame().2,
-        holes: goal.internal_holes(),
         filled: vec![false; goal.slots()],
-        attracted: vec![false; goal.slots()],
-        asked: FxHashMap::default(),
-        waiting: FxHashMap::default(),
+        taken: vec![false; goal.slots()],
+        row_of,
+        col_of,
+        row_taken: vec![0; rows],
+        col_taken: vec![0; cols],
         heap: BinaryHeap::new(),
         seq: 0,
         now: 0,
@@ -356,21 +332,23 @@ pub fn run(goal: &Goal, seed_cell: (i32, i32), seed: u64, delays: &Delays) -> Ru
             seed_cell,
         },
     };
-    let _ = sim.w;
     let s = sim.slot(seed_cell.0, seed_cell.1);
+    sim.taken[s] = true;
+    sim.row_taken[sim.row_of[s]] += 1;
+    sim.col_taken[sim.col_of[s]] += 1;
     sim.dock(s, None);
     while let Some(Reverse((t, _, ev))) = sim.heap.pop() {
         sim.now = t;
         match ev {
+            Ev::Attract { slot, by } => {
+                // The signal reaches the cell: it is now a docking position.
+                sim.pending += 1;
+                let t = sim.now + sim.delay(sim.delays.dock);
+                sim.push(t, Ev::Dock { slot, by });
+            }
             Ev::Dock { slot, by } => {
-                sim.attracted[slot] = false;
                 sim.pending -= 1;
                 sim.dock(slot, Some(by));
-            }
-            Ev::Grant { module, target } => {
-                let (x, y) = sim.xy(target);
-                sim.asked.remove(&(module, target));
-                sim.attract(x, y, module);
             }
         }
     }
