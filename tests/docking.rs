@@ -251,6 +251,7 @@ fn rule1_is_never_looser_than_the_geometry_on_the_square_lattice() {
             stricter += 1;
         }
     }
+    println!("{cases} neighbourhoods: Rule 1 stricter in {stricter}, looser in {looser}");
     assert_eq!(cases, 240);
     assert_eq!(looser, 0, "Rule 1 allows a docking the geometry forbids");
     assert!(stricter > 0);

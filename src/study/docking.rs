@@ -16,10 +16,9 @@ use serde::Serialize;
 use std::path::Path;
 
 /// The paper's four shape classes: (name, CSG file in `models/docking/`,
-/// base scale). The power button's base scale gives the paper's 815
-/// modules (its ×2 and ×4 give 3,221 and 12,853 against the paper's 3,318
-/// and 13,233, which no single scale reproduces); the others' give
-/// comparable sizes.
+/// base scale). The power button's base scale gives 824, 3,335 and 13,420
+/// modules at ×1, ×2, ×4 (the paper: 815, 3,318, 13,233); the others'
+/// give comparable sizes.
 pub const SHAPES: &[(&str, &str, f64)] = &[
     ("power button", "power-button.csg", 1.79),
     ("letter C", "letter-c.csg", 0.62),

@@ -1,29 +1,29 @@
 //! The 2D planner of seed 002 (Tucci, Piranda, Bourgeois, §4.1), its
 //! distributed behaviour simulated centrally as a discrete-event run.
 //!
-//! Every module in place runs the same rules on its own neighbourhood:
+//! The paper keeps two conditions (§3.2): **one contiguous line of modules
+//! per row**, which its seed rules enforce (Rules 2–3 elect one seed per
+//! row, Rules 4–5 withdraw the second seed where a row merges over a hole),
+//! and **attraction in an existing row only once the corner cell is in
+//! place** (Fig. 6, Algorithm 2: west waits for south-west, east for
+//! north-east), which makes each column grow as one line too. The planner
+//! keeps both as they act on the cells: a module attracts a free goal
+//! neighbour `c` when `c`'s row-run (maximal run of goal cells in its row)
+//! is empty or `c` touches that run's line, and the same holds for `c`'s
+//! column-run. A run's line is started by one module only (the first
+//! attraction reserves the run, as the seed election does); after that it
+//! grows at its ends. So no free cell ever lies between two modules of its
+//! row or column: Rule 1 is never broken, and no cell is left unfillable.
 //!
-//! * **Rules 2–3 (seeds).** A module attracts its north cell when it is a
-//!   north seed — `N ∈ G` and (`NE ∉ G` or `E ∉ G`), the rightmost module
-//!   under its north row — and its south cell when it is a south seed, the
-//!   mirror image (leftmost).
-//! * **Rules 4–5 (row merges).** A would-be north seed whose row, east of
-//!   it, passes a gap under the north row and then continues, is not a seed
-//!   when the gap is an internal hole: the row beyond the hole seeds the
-//!   north row, so each row is one contiguous line. An external gap (open
-//!   to the outside) cannot be reached from the other side first, so there
-//!   the module stays a seed.
-//! * **Algorithm 2 (west/east attraction).** West is attracted at once
-//!   when `SW ∉ G`; otherwise only once `SW` is in place (the corner rule
-//!   of Fig. 6): the south neighbour, when present, tells (one message);
-//!   when `S ∉ G` the module is on a hole or concavity border and learns it
-//!   by border following (the reply costs two messages a hop); when `S` is
-//!   in the goal but empty, it attracts `S` first. East is the mirror image
-//!   with `NE` and `N`.
+//! A module learns the condition across its attraction from the corner
+//! cell: through its neighbour next to the corner (one permission reply),
+//! or, when that neighbour is not in the goal (a hole or concavity), by
+//! border following — the shortest path through goal cells around the
+//! border, two messages a hop for the reply.
 //!
-//! Delays are random (seeded RNG): a docking takes `dock_delay` time units
-//! after its attraction, a message `message_delay` per hop, so each seed
-//! gives another docking order, as the authors' simulations did.
+//! Delays are random (seeded RNG): a permission takes `message_delay` per
+//! hop, a docking `dock_delay` after its attraction, so each seed gives
+//! another docking order, as the authors' simulations did.
 //!
 //! Messages are counted as the authors' simulator counts them (see the
 //! facts of seed 002): on arrival, a request and a reply to each connected
