@@ -48,21 +48,21 @@ pub fn candidates(lattice: &dyn Lattice, cell: Cell) -> Vec<Approach> {
         // on either side perpendicular to d.
         let from = cell + d;
         for s in axes.iter().filter(|s| s.x * d.x + s.y * d.y == 0) {
-            out.push(approach(lattice, from, from + *s, cell));
+            out.push(approach(from, from + *s, cell));
         }
     }
     for (dx, dy) in [(1, 1), (-1, 1), (-1, -1), (1, -1)] {
         // Corner move from the diagonal neighbour around either corner.
         let from = Cell::xy(cell.x + dx, cell.y + dy);
         for pivot in [Cell::xy(cell.x + dx, cell.y), Cell::xy(cell.x, cell.y + dy)] {
-            out.push(approach(lattice, from, pivot, cell));
+            out.push(approach(from, pivot, cell));
         }
     }
     out.retain(|a| lattice.move_requirements(&a.motion).is_ok());
     out
 }
 
-fn approach(_lattice: &dyn Lattice, from: Cell, pivot: Cell, to: Cell) -> Approach {
+fn approach(from: Cell, pivot: Cell, to: Cell) -> Approach {
     Approach {
         from,
         pivot,
