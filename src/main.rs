@@ -53,6 +53,10 @@ enum Command {
     /// Seed 003 §V-B1: active subtraction on random configurations of
     /// several densities; prints a table and draws a box plot.
     DensityStudy(cli::density::Args),
+    /// Seed 002: messages against modules (Fig. 10), available docking
+    /// positions against percent built (Fig. 11) and the naive orders of
+    /// Fig. 3, as tables.
+    DockingStudy(cli::docking::Args),
     /// Derive the FCC motion rules (cells blocking each of the 120 rotation
     /// links) from the catom geometry and print them as a table.
     Rules {
@@ -101,6 +105,7 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
         #[cfg(feature = "render")]
         Command::Loadmap(a) => cli::pictures::loadmap(a),
         Command::DensityStudy(a) => cli::density::run(a),
+        Command::DockingStudy(a) => cli::docking::run(a),
         Command::Rules { json } => {
             let t = reconfcheck::geometry::table();
             print!("{}", t.to_text());

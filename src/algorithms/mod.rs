@@ -8,6 +8,7 @@
 
 pub mod active_subtraction;
 pub mod branch;
+pub mod docking;
 pub mod random_walk;
 pub mod scaffold;
 pub mod schedule_file;
@@ -34,6 +35,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &active_subtraction::ActiveSubtraction,
         &branch::Branch,
         &scaffold::ScaffoldAssembly,
+        &docking::Docking,
     ]
 }
 

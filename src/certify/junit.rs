@@ -14,6 +14,7 @@ pub fn check_of(kind: ViolationKind) -> &'static str {
     match kind {
         ViolationKind::Collision | ViolationKind::SlidingContact => "collision",
         ViolationKind::Unstable | ViolationKind::Overload => "mechanics",
+        ViolationKind::DockingBlocked => "docking",
         _ => "lattice",
     }
 }

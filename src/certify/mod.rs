@@ -6,6 +6,7 @@
 
 pub(crate) mod baseline;
 pub(crate) mod collision_check;
+pub(crate) mod docking_check;
 pub(crate) mod junit;
 pub(crate) mod lattice_check;
 pub(crate) mod load_check;
@@ -14,6 +15,7 @@ pub(crate) mod world;
 
 pub use baseline::{Comparison, Rise, compare as compare_with_baseline, load as load_baseline};
 pub use collision_check::CollisionCheck;
+pub use docking_check::DockingCheck;
 pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
 pub use load_check::{LoadCheck, replay};
@@ -177,6 +179,16 @@ pub fn checks_for(
             model,
             epsilon: opts.epsilon,
             exact: opts.exact,
+        }));
+    }
+    let docks = schedule
+        .steps
+        .iter()
+        .flat_map(|s| &s.events)
+        .any(|e| matches!(e, crate::schedule::Event::Dock { .. }));
+    if docks {
+        checks.push(Box::new(DockingCheck {
+            epsilon: opts.epsilon,
         }));
     }
     if let Some(path) = model_path(schedule, opts) {

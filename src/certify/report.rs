@@ -36,6 +36,10 @@ pub enum ViolationKind {
     Collision,
     /// A mover slides in contact with a module that is not its pivot.
     SlidingContact,
+    /// A docking's final approach is not clear by the exact geometry (seed
+    /// 002): origin or passage occupied, a support missing, or a module
+    /// penetrated along the sweep.
+    DockingBlocked,
     /// The structure has no static equilibrium under gravity.
     Unstable,
     /// A connector load exceeds its capacity.
@@ -50,6 +54,7 @@ impl ViolationKind {
             self,
             ViolationKind::Collision
                 | ViolationKind::SlidingContact
+                | ViolationKind::DockingBlocked
                 | ViolationKind::Unstable
                 | ViolationKind::Overload
         )

@@ -44,6 +44,18 @@ pub struct Move {
     pub pivot_resolved: bool,
 }
 
+/// A docking's final approach, resolved: the lattice move from `motion.from()`
+/// into the docked cell on the pivot (`None` when the pivot has left the
+/// scene: the certifier reports it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dock {
+    pub module: ModuleId,
+    pub pivot: ModuleId,
+    pub pivot_cell: Option<Cell>,
+    pub motion: Motion,
+    pub requirements: MoveRequirements,
+}
+
 /// A step's events, resolved and grouped.
 #[derive(Clone, Debug, Default)]
 pub struct StepPlan {
@@ -54,6 +66,9 @@ pub struct StepPlan {
     pub leaves: Vec<ModuleId>,
     pub attaches: Vec<(ModuleId, ModuleId)>,
     pub detaches: Vec<(ModuleId, ModuleId)>,
+    /// Seed 002 dockings (each also listed in `enters`), with their final
+    /// approach resolved against the scene.
+    pub docks: Vec<Dock>,
     /// Modules that are not static during the step (movers and leavers).
     pub moving: FxHashSet<ModuleId>,
     /// Violations found while resolving (missing pivots, double moves).
@@ -343,6 +358,59 @@ impl World {
                     }
                     self.check_cell(*cell).map_err(|e| err(e.message))?;
                     plan.enters.push((id, *cell));
+                }
+                Event::Dock {
+                    cell,
+                    pivot,
+                    from,
+                    route,
+                    ..
+                } => {
+                    if self.config.contains(id) {
+                        return Err(err(format!(
+                            "module {id} docks but is already in the scene"
+                        )));
+                    }
+                    for c in [*cell, *from] {
+                        self.check_cell(c).map_err(|e| err(e.message))?;
+                    }
+                    let pivot_cell = self.config.cell_of(*pivot);
+                    if pivot_cell.is_none() && !self.left_at.contains_key(pivot) {
+                        return Err(err(format!("unknown pivot module id {pivot}")));
+                    }
+                    let motion = match self.lattice.kind() {
+                        crate::lattice::LatticeKind::Fcc => Motion::Rotate {
+                            from: *from,
+                            to: *cell,
+                            pivot: pivot_cell.unwrap_or(*from),
+                            route: route.ok_or_else(|| {
+                                err("a docking on the FCC lattice needs its rotation's route"
+                                    .into())
+                            })?,
+                        },
+                        _ => Motion::Slide {
+                            from: *from,
+                            to: *cell,
+                            pivot: pivot_cell,
+                        },
+                    };
+                    let requirements = match pivot_cell {
+                        Some(_) => self.lattice.move_requirements(&motion).map_err(|e| {
+                            err(format!(
+                                "docking approach is not a {} move: {e}",
+                                self.lattice.kind().name()
+                            ))
+                        })?,
+                        None => MoveRequirements::default(),
+                    };
+                    plan.enters.push((id, *cell));
+                    plan.docks.push(Dock {
+                        module: id,
+                        pivot: *pivot,
+                        pivot_cell,
+                        motion,
+                        requirements,
+                    });
                 }
                 Event::Leave { .. } => {
                     self.require_present(id, step)?;

@@ -5,6 +5,7 @@
 
 pub mod b_study;
 pub mod density;
+pub mod docking;
 #[cfg(feature = "render")]
 pub mod figures;
 pub mod interop;

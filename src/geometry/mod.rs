@@ -5,6 +5,7 @@
 //! contacts it reports into violations and warnings.
 
 pub(crate) mod catom;
+pub mod docking;
 pub(crate) mod fcc_sweep;
 pub(crate) mod rolling;
 pub(crate) mod rules;

@@ -690,7 +690,7 @@ pub fn config_at_step(s: &Schedule, step: usize) -> Result<BTreeMap<u32, Cell>, 
                     let end = *path.last().ok_or_else(unknown)?;
                     *at.get_mut(&id).ok_or_else(unknown)? = end;
                 }
-                Event::Enter { cell, .. } => {
+                Event::Enter { cell, .. } | Event::Dock { cell, .. } => {
                     at.insert(id, *cell);
                 }
                 Event::Leave { .. } => {

@@ -97,6 +97,17 @@ pub enum Event {
     Tunnel { module: ModuleId, path: Vec<Cell> },
     /// A new module enters the scene at `cell` (from a sandbox or reserve).
     Enter { module: ModuleId, cell: Cell },
+    /// Seed 002 docking: a new module joins the structure at `cell`, its
+    /// final approach the lattice move from the free cell `from` on `pivot`
+    /// (a module already in the structure). `route` is needed on FCC only.
+    Dock {
+        module: ModuleId,
+        cell: Cell,
+        pivot: ModuleId,
+        from: Cell,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        route: Option<Route>,
+    },
     /// `module` leaves the scene through the sink cell it is in at the end
     /// of this step (it may arrive there by a move in the same step).
     Leave { module: ModuleId },
@@ -114,6 +125,7 @@ impl Event {
             | Event::Slide { module, .. }
             | Event::Tunnel { module, .. }
             | Event::Enter { module, .. }
+            | Event::Dock { module, .. }
             | Event::Leave { module }
             | Event::Attach { module, .. }
             | Event::Detach { module, .. } => *module,
@@ -161,7 +173,7 @@ impl Schedule {
         let (mut enter, mut leave) = (0usize, 0usize);
         for e in self.steps.iter().flat_map(|s| &s.events) {
             match e {
-                Event::Enter { .. } => enter += 1,
+                Event::Enter { .. } | Event::Dock { .. } => enter += 1,
                 Event::Leave { .. } => leave += 1,
                 _ => {}
             }
@@ -246,6 +258,7 @@ impl Schedule {
                     }
                     Event::Tunnel { path, .. } => path.iter().collect(),
                     Event::Enter { cell, .. } => vec![cell],
+                    Event::Dock { cell, from, .. } => vec![cell, from],
                     Event::Leave { .. } | Event::Attach { .. } | Event::Detach { .. } => vec![],
                 };
                 if let Some(c) = cells.into_iter().find(|c| far(c)) {

@@ -4,5 +4,6 @@
 
 pub mod b_study;
 pub mod density;
+pub mod docking;
 pub mod scaffold_figures;
 pub mod synthetic;

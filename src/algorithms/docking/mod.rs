@@ -1,0 +1,186 @@
+//! Seed 002, "Distributed self-assembly planning by docking" (Tucci,
+//! Piranda, Bourgeois): a dense goal shape grows from one seed module;
+//! modules in place attract new ones to docking positions in an order that
+//! never leaves a goal cell impossible to fill.
+//!
+//! * [`goal`] — goal shapes (CSG slices), validated;
+//! * [`rule1`] — the paper's docking rule (the planner's, not the
+//!   certifier's);
+//! * [`planner`] — Rules 2–5, Algorithm 2 and border following, simulated
+//!   as a distributed run with random delays;
+//! * [`naive`] — the two naive orders of Fig. 3.
+//!
+//! The generator emits one `dock` event per time step, in the run's
+//! docking order, each with a final approach (origin cell and pivot) that
+//! the geometry layer finds clear. See `docs/docking.md`.
+
+pub mod goal;
+pub mod naive;
+pub mod planner;
+pub mod rule1;
+
+use super::{Generator, parameters};
+use crate::error::InputError;
+use crate::geometry::Tolerance;
+use crate::geometry::docking::{Approach, candidates, clear_approaches};
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Cell, Configuration, LatticeKind, SquareLattice};
+use crate::scenario::Scenario;
+use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
+use goal::Goal;
+use planner::{Delays, Run};
+use serde::Deserialize;
+
+/// Scenario parameters of `docking`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// Goal shape: a CSG file (relative to the scenario), sliced at `z`.
+    pub shape: String,
+    /// Scale applied to the CSG (cells per CSG unit).
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Height of the slice, in CSG units.
+    #[serde(default)]
+    pub z: f64,
+    /// RNG seed of the simulated delays.
+    #[serde(default)]
+    pub seed: u64,
+    /// The seed module's cell (default: the goal cell nearest the centroid).
+    #[serde(default)]
+    pub seed_cell: Option<[i32; 2]>,
+    #[serde(default)]
+    pub delays: Option<Delays>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The planner's run and the schedule made from it.
+pub struct Planned {
+    pub goal: Goal,
+    pub run: Run,
+    pub schedule: Schedule,
+    /// Dockings for which the geometry found no clear approach (the
+    /// schedule still names one; certification reports it).
+    pub without_approach: usize,
+}
+
+/// Checks a goal and its seed cell; the default seed cell is the goal cell
+/// nearest the centroid.
+pub fn seed_cell_of(goal: &Goal, seed_cell: Option<[i32; 2]>) -> Result<(i32, i32), InputError> {
+    goal.validate()?;
+    match seed_cell {
+        Some([x, y]) if goal.contains(x, y) => Ok((x, y)),
+        Some([x, y]) => Err(InputError::new(format!(
+            "goal '{}' has no cell for the seed at ({x}, {y})",
+            goal.name
+        ))),
+        None => Ok(goal.central_cell()),
+    }
+}
+
+/// Plans `goal` and emits its schedule.
+pub fn plan(
+    goal: Goal,
+    seed_cell: Option<[i32; 2]>,
+    seed: u64,
+    delays: &Delays,
+) -> Result<Planned, InputError> {
+    let start = seed_cell_of(&goal, seed_cell)?;
+    let run = planner::run(&goal, start, seed, delays);
+    let (schedule, without_approach) = emit(&goal, &run);
+    Ok(Planned {
+        goal,
+        run,
+        schedule,
+        without_approach,
+    })
+}
+
+/// The schedule of a run: the seed fixed in place, then one docking per
+/// step. Each docking's approach is the first clear one on the module that
+/// attracted it, else the first clear one, else (none clear) a corner
+/// approach on the attractor, left for certification to refuse.
+fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
+    let lattice = &SquareLattice;
+    let mut s = Schedule::new(LatticeKind::Square, Length::mm(50.0));
+    let mut config = Configuration::new();
+    let seed = Cell::xy(run.seed_cell.0, run.seed_cell.1);
+    s.modules.push(ModuleSpec {
+        id: 0,
+        cell: seed,
+        fixed: true,
+    });
+    config.insert(0, seed).expect("empty scene");
+    let mut without = 0;
+    for (k, d) in run.order.iter().enumerate().skip(1) {
+        let id = k as ModuleId;
+        let cell = Cell::xy(d.cell.0, d.cell.1);
+        let attractor = d.attractor.map(|(x, y)| Cell::xy(x, y));
+        let clear = clear_approaches(lattice, &config, cell, Tolerance::DEFAULT);
+        let pick = |list: &[Approach]| -> Option<Approach> {
+            list.iter()
+                .find(|a| Some(a.pivot) == attractor)
+                .or_else(|| list.first())
+                .cloned()
+        };
+        let approach = pick(&clear).unwrap_or_else(|| {
+            without += 1;
+            let all = candidates(lattice, cell);
+            all.iter()
+                .find(|a| Some(a.pivot) == attractor && a.from.x != cell.x && a.from.y != cell.y)
+                .or_else(|| all.first())
+                .cloned()
+                .expect("the square lattice has approaches")
+        });
+        let pivot = config.at(approach.pivot).unwrap_or(0);
+        s.steps.push(Step {
+            events: vec![Event::Dock {
+                module: id,
+                cell,
+                pivot,
+                from: approach.from,
+                route: None,
+            }],
+        });
+        config
+            .insert(id, cell)
+            .expect("the planner docks a cell once");
+    }
+    s.meta.insert("algorithm".into(), "docking".into());
+    s.meta.insert("goal".into(), goal.name.clone().into());
+    s.meta.insert("modules".into(), goal.len().into());
+    s.meta
+        .insert("messages".into(), run.messages.total().into());
+    s.meta
+        .insert("rule1_violations".into(), run.rule1_violations.into());
+    s.meta.insert("unfilled".into(), run.unfilled.into());
+    (s, without)
+}
+
+/// The `docking` generator.
+pub struct Docking;
+
+impl Generator for Docking {
+    fn name(&self) -> &'static str {
+        "docking"
+    }
+
+    fn about(&self) -> &'static str {
+        "seed 002: distributed self-assembly by docking on the square lattice (Rules 1-5, border following)"
+    }
+
+    fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
+        let p: Params = parameters(scenario)?;
+        let path = scenario.resolve(&p.shape);
+        let goal = Goal::from_csg(&path, p.scale, p.z)?;
+        let seed_cell = p.seed_cell;
+        let planned = plan(goal, seed_cell, p.seed, &p.delays.unwrap_or_default())
+            .map_err(|e| e.in_file(&path))?;
+        let mut s = planned.schedule;
+        s.meta.insert("seed".into(), p.seed.into());
+        Ok(s)
+    }
+}
