@@ -7,7 +7,9 @@
 //! `src/lib.rs`): a generator implements its paper, the certifier judges.
 
 pub mod active_subtraction;
+pub mod atom_moves;
 pub mod branch;
+pub mod comb;
 pub mod random_walk;
 pub mod scaffold;
 pub mod schedule_file;
@@ -34,6 +36,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &active_subtraction::ActiveSubtraction,
         &branch::Branch,
         &scaffold::ScaffoldAssembly,
+        &comb::Comb2d,
     ]
 }
 
