@@ -141,19 +141,28 @@ impl Robot {
             let mut events = Vec::new();
             let mut moves = Vec::new();
             let mut relatch = Vec::new();
+            let mut sliders = FxHashSet::default();
+            let mut loosen = Vec::new();
             for &(x0, x1) in &components {
                 for (end, side) in [(x0, x0 - 1), (x1, x1 + 1)] {
-                    if let Some(s) = self.get((side, wall)) {
-                        let a = self.get((end, wall)).expect("wall meta-module");
-                        let below = self.get((side, wall - 1)).expect("stationary");
-                        events.push(Event::Slide {
-                            module: a as ModuleId,
-                            from: cell((end, wall)),
-                            to: cell((end, wall - 1)),
-                            pivot: Some(s as ModuleId),
-                        });
-                        relatch.push((a, s, below));
+                    let (Some(s), Some(a)) = (self.get((side, wall)), self.get((end, wall))) else {
+                        continue;
+                    };
+                    if !sliders.insert(a) {
+                        // A lone moving meta-module between two stationary
+                        // ones slides along the first and lets go of the
+                        // second before the move.
+                        loosen.push((a, s));
+                        continue;
                     }
+                    let below = self.get((side, wall - 1)).expect("stationary");
+                    events.push(Event::Slide {
+                        module: a as ModuleId,
+                        from: cell((end, wall)),
+                        to: cell((end, wall - 1)),
+                        pivot: Some(s as ModuleId),
+                    });
+                    relatch.push((a, s, below));
                 }
                 for x in x0..=x1 {
                     let mut y = wall;
@@ -163,7 +172,19 @@ impl Robot {
                     }
                 }
             }
-            if events.is_empty() {
+            // The carried meta-modules move with their sliders.
+            for &(k, to) in &moves {
+                if !sliders.contains(&k) {
+                    events.push(Event::Slide {
+                        module: k as ModuleId,
+                        from: cell(self.at[k]),
+                        to: cell(to),
+                        pivot: None,
+                    });
+                }
+            }
+            self.latch_step(loosen, false);
+            if sliders.is_empty() {
                 wall -= 1;
                 continue;
             }
@@ -306,13 +327,16 @@ pub fn parse_picture(text: &str) -> BTreeSet<(i32, i32)> {
 pub fn meta_schedule(start: &Shape, steps: &[Vec<Event>], rest: AtomRest) -> Schedule {
     let mut s = Schedule::new(LatticeKind::Cubic, Length::mm(120.0));
     s.meta_modules = Some(rest);
+    // The frame: the leftmost meta-module of the lowest row, which neither
+    // the combing nor the comb-to-common-comb moves.
+    let anchor = start.iter().min_by_key(|c| (c.1, c.0)).copied();
     s.modules = start
         .iter()
         .enumerate()
         .map(|(k, &c)| ModuleSpec {
             id: k as ModuleId,
             cell: cell(c),
-            fixed: false,
+            fixed: Some(c) == anchor,
         })
         .collect();
     s.steps = steps.iter().map(|e| Step { events: e.clone() }).collect();
