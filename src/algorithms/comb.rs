@@ -1,14 +1,14 @@
-//! Seed 004 in 2D (Aloupis et al., §3.1, Theorem 1): the source robot of
-//! 2×2×2 meta-modules is combed (Algorithm 1, the wall sweep), turned into
-//! the common comb (Algorithm 2, 1- and 2-TUNNEL), and the target's own
-//! combing and comb-to-common-comb are played backwards.
+//! Seed 004 in 2D (Aloupis et al., §3.1): the source robot of 2×2×2
+//! meta-modules is combed (Algorithm 1, the wall sweep). The rest of
+//! Theorem 1 (COMB-TO-COMMON-COMB and the target's reverse) needs k-TUNNEL,
+//! which this build has not derived at atom level: not generated.
 //!
 //! The generator works on meta-modules (cells of the coarse cubic lattice,
 //! `z = 0`) and writes a `meta_modules` schedule: `slide` (the paper's
 //! SLIDE, carrying whatever is attached to the slider; `pivot` is the wall
-//! meta-module B), `tunnel` (k-TUNNEL: the meta-module at the path's start
-//! ends at its end), `attach` and `detach` of whole meta-modules. The
-//! certifier expands that schedule into atom operations.
+//! meta-module B; carried meta-modules get a `slide` without pivot),
+//! `attach` and `detach` of whole meta-modules. The certifier expands that
+//! schedule into atom operations.
 
 use super::{Generator, parameters};
 use crate::error::InputError;
@@ -184,11 +184,9 @@ impl Robot {
                 }
             }
             self.latch_step(loosen, false);
-            if sliders.is_empty() {
-                wall -= 1;
-                continue;
+            if !sliders.is_empty() {
+                self.steps.push(events);
             }
-            self.steps.push(events);
             for (a, s, below) in relatch {
                 self.attached.remove(&pair(a, s));
                 self.attached.insert(pair(a, below));
@@ -361,10 +359,6 @@ pub struct CombParams {
     /// The atoms' rest model: `"contracted"` (default) or `"expanded"`.
     #[serde(default = "default_rest")]
     pub model: AtomRest,
-    /// `"comb"`: only Algorithm 1 on the source; `"full"` (default):
-    /// Theorem 1, source to target.
-    #[serde(default = "default_phases")]
-    pub phases: String,
 }
 
 fn default_metas() -> usize {
@@ -372,9 +366,6 @@ fn default_metas() -> usize {
 }
 fn default_rest() -> AtomRest {
     AtomRest::Contracted
-}
-fn default_phases() -> String {
-    "full".into()
 }
 
 /// The source and target a scenario names, as meta-module shapes.
@@ -420,35 +411,23 @@ impl Generator for Comb2d {
     }
 
     fn about(&self) -> &'static str {
-        "seed 004 in 2D: combing, comb to common comb, and back to the target (meta-module schedule)"
+        "seed 004 in 2D: COMBING (Algorithm 1) of the source, as a meta-module schedule"
     }
 
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
         let p: CombParams = parameters(scenario)?;
         let (src, tgt) = shapes(scenario, &p)?;
-        let steps = match p.phases.as_str() {
-            "comb" => {
-                let mut r = Robot::new(&src);
-                r.comb();
-                r.steps
-            }
-            "full" => reconfigure(&src, &tgt)?,
-            other => {
-                return Err(scenario.error(format!("unknown phases '{other}' (known: comb, full)")));
-            }
-        };
+        // The target is read and checked (2×2 blocks, connected, same
+        // count) but not yet reached: COMB-TO-COMMON-COMB and the reverse
+        // need k-TUNNEL at atom level (docs/atoms.md).
+        let _ = tgt;
+        let mut r = Robot::new(&src);
+        r.comb();
+        let steps = r.steps;
         let mut s = meta_schedule(&src, &steps, p.model);
         s.meta.insert("algorithm".into(), "comb-2d".into());
         s.meta.insert("meta_modules".into(), src.len().into());
         s.meta.insert("seed".into(), p.seed.into());
         Ok(s)
     }
-}
-
-/// Theorem 1: the steps that take `src` to `tgt` (same meta-module count).
-pub fn reconfigure(src: &Shape, tgt: &Shape) -> Result<Vec<Vec<Event>>, InputError> {
-    let _ = tgt;
-    let mut r = Robot::new(src);
-    r.comb();
-    Ok(r.steps)
 }
