@@ -142,19 +142,14 @@ impl Robot {
             let mut moves = Vec::new();
             let mut relatch = Vec::new();
             let mut sliders = FxHashSet::default();
-            let mut loosen = Vec::new();
             for &(x0, x1) in &components {
                 for (end, side) in [(x0, x0 - 1), (x1, x1 + 1)] {
                     let (Some(s), Some(a)) = (self.get((side, wall)), self.get((end, wall))) else {
                         continue;
                     };
-                    if !sliders.insert(a) {
-                        // A lone moving meta-module between two stationary
-                        // ones slides along the first and lets go of the
-                        // second before the move.
-                        loosen.push((a, s));
-                        continue;
-                    }
+                    // A lone moving meta-module between two stationary
+                    // ones slides along both (two events, one per wall).
+                    sliders.insert(a);
                     let below = self.get((side, wall - 1)).expect("stationary");
                     events.push(Event::Slide {
                         module: a as ModuleId,
@@ -183,7 +178,6 @@ impl Robot {
                     });
                 }
             }
-            self.latch_step(loosen, false);
             if !sliders.is_empty() {
                 self.steps.push(events);
             }

@@ -36,6 +36,27 @@ pub struct SlideLibrary {
     pub steps: Vec<Vec<Op>>,
 }
 
+/// The SLIDE between two walls, searched once per process.
+pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
+    static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    let cell = match rest {
+        AtomRest::Contracted => &CONTRACTED,
+        AtomRest::Expanded => &EXPANDED,
+    };
+    cell.get_or_init(|| {
+        let problem = super::atom_search::double_slide_problem(rest);
+        let found = problem.solve()?;
+        let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+        Some(SlideLibrary {
+            problem,
+            found,
+            steps,
+        })
+    })
+    .as_ref()
+}
+
 /// The library of `rest`, searched once per process.
 pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
@@ -56,10 +77,6 @@ pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     })
     .as_ref()
 }
-
-/// The canonical meta-modules the library's operations name: B, C, A (in
-/// the order of [`slide_problem`]) and their canonical cells.
-const CANONICAL: [(i32, i32); 3] = [(1, 0), (0, 0), (1, 1)];
 
 /// A signed axis permutation (a lattice symmetry, mirror images included).
 #[derive(Copy, Clone, Debug)]
@@ -175,12 +192,13 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
             a
         }));
     }
-    let mut library: Option<&SlideLibrary> = None;
     for (k, step) in s.steps.iter().enumerate() {
         let k1 = k + 1;
         let mut latch: Vec<Event> = Vec::new();
         let mut slides: Vec<Vec<Vec<Event>>> = Vec::new();
         let mut moved: Vec<(ModuleId, Cell)> = Vec::new();
+        let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
+            FxHashMap::default();
         for e in &step.events {
             let id = e.module();
             let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
@@ -221,7 +239,9 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                     if d.l1() != 1 {
                         return Err(err(format!("a SLIDE moves one cell, not {from} to {to}")));
                     }
-                    moved.push((id, *to));
+                    if !moved.iter().any(|&(m, _)| m == id) {
+                        moved.push((id, *to));
+                    }
                     let Some(b) = pivot else { continue };
                     let cb = *at.get(b).ok_or_else(|| {
                         err(format!("the wall meta-module {b} is not in the robot"))
@@ -235,52 +255,7 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                     let c = *by_cell.get(&(cb + d)).ok_or_else(|| {
                         err(format!("SLIDE needs a meta-module at {} (beside the wall, in the slide direction)", cb + d))
                     })?;
-                    let lib = match library {
-                        Some(l) => l,
-                        None => {
-                            let l = slide_library(rest).ok_or_else(|| {
-                                err("no atom sequence for SLIDE was found by the search".into())
-                            })?;
-                            library = Some(l);
-                            l
-                        }
-                    };
-                    let turn = Turn::new(d, w);
-                    let ids = [*b, c, id];
-                    let atom = |q: usize| -> ModuleId {
-                        let a2 = q / 2;
-                        let meta = a2 / 4;
-                        let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
-                        debug_assert!(meta < CANONICAL.len(), "library names only A, B, C");
-                        ids[meta] * 8 + turn.local(i, j, (q % 2) as i32)
-                    };
-                    let steps: Vec<Vec<Event>> = lib
-                        .steps
-                        .iter()
-                        .map(|st| {
-                            st.iter()
-                                .map(|op| match *op {
-                                    Op::Expand(a, f) => Event::Expand {
-                                        module: atom(a),
-                                        face: turn.face(f),
-                                    },
-                                    Op::Contract(a, f) => Event::Contract {
-                                        module: atom(a),
-                                        face: turn.face(f),
-                                    },
-                                    Op::Attach(a, b) => Event::Attach {
-                                        module: atom(a),
-                                        other: atom(b),
-                                    },
-                                    Op::Detach(a, b) => Event::Detach {
-                                        module: atom(a),
-                                        other: atom(b),
-                                    },
-                                })
-                                .collect()
-                        })
-                        .collect();
-                    slides.push(steps);
+                    walls.entry(id).or_default().push((d, w, *b, c));
                 }
                 Event::Tunnel { .. } => {
                     return Err(err(
@@ -293,6 +268,65 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                     ));
                 }
             }
+        }
+        let mut ids_in_order: Vec<ModuleId> = walls.keys().copied().collect();
+        ids_in_order.sort_unstable();
+        for id in ids_in_order {
+            let ws = &walls[&id];
+            let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
+            let (lib, ids, (d, w)) = match ws.as_slice() {
+                [(d, w, b, c)] => {
+                    let lib = slide_library(rest).ok_or_else(|| {
+                        err("no atom sequence for SLIDE was found by the search".into())
+                    })?;
+                    (lib, vec![*b, *c, id], (*d, *w))
+                }
+                [(d, w, b, c), (d2, w2, b2, c2)] if d == d2 && *w2 == Cell::ZERO - *w => {
+                    let lib = double_slide_library(rest).ok_or_else(|| {
+                        err("no atom sequence for a SLIDE between two walls was found by the search".into())
+                    })?;
+                    (lib, vec![*b, *c, id, 0, 0, *b2, *c2], (*d, *w))
+                }
+                _ => {
+                    return Err(err(
+                        "a meta-module slides along one wall, or along two opposite walls in the same direction".into(),
+                    ));
+                }
+            };
+            let turn = Turn::new(d, w);
+            let atom = |q: usize| -> ModuleId {
+                let a2 = q / 2;
+                let meta = a2 / 4;
+                let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
+                ids[meta] * 8 + turn.local(i, j, (q % 2) as i32)
+            };
+            let steps: Vec<Vec<Event>> = lib
+                .steps
+                .iter()
+                .map(|st| {
+                    st.iter()
+                        .map(|op| match *op {
+                            Op::Expand(a, f) => Event::Expand {
+                                module: atom(a),
+                                face: turn.face(f),
+                            },
+                            Op::Contract(a, f) => Event::Contract {
+                                module: atom(a),
+                                face: turn.face(f),
+                            },
+                            Op::Attach(a, b) => Event::Attach {
+                                module: atom(a),
+                                other: atom(b),
+                            },
+                            Op::Detach(a, b) => Event::Detach {
+                                module: atom(a),
+                                other: atom(b),
+                            },
+                        })
+                        .collect()
+                })
+                .collect();
+            slides.push(steps);
         }
         if !latch.is_empty() {
             out.steps.push(Step { events: latch });

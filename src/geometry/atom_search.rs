@@ -453,6 +453,54 @@ pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, 
     (problem, label)
 }
 
+/// The SLIDE of a lone meta-module between two walls (seed 004 Alg. 1: a
+/// moving wall component of one meta-module with stationary neighbours on
+/// both sides slides along both, so that the robot stays connected through
+/// it). The scene of [`slide_problem`] without carried meta-modules, plus
+/// a second wall B′ (1, 2) and C′ (0, 2) on A's far side, which must not
+/// move (they may hang on A alone). Atom order: B, C, A, F, H, B′, C′.
+pub fn double_slide_problem(rest: crate::lattice::AtomRest) -> Problem {
+    let (mut p, _) = slide_problem(rest, Carry::None);
+    let sp = rest_spacing(rest);
+    let n0 = p.start.pos.len();
+    let mut pos = p.start.pos.clone();
+    pos.extend(meta_atoms_2d(1, 2, sp));
+    pos.extend(meta_atoms_2d(0, 2, sp));
+    let mut goal_pos = p.goal.pos.clone();
+    goal_pos.extend(meta_atoms_2d(1, 2, sp));
+    goal_pos.extend(meta_atoms_2d(0, 2, sp));
+    let ext = vec![p.start.ext[0]; pos.len()];
+    let is_a = |a: usize| (8..12).contains(&a);
+    let is_b2 = |a: usize| (n0..n0 + 4).contains(&a);
+    let is_c2 = |a: usize| (n0 + 4..n0 + 8).contains(&a);
+    let mut bonds = p.start.bonds.clone();
+    for (a, b) in Scene::all_bonds(&pos, &ext) {
+        if b >= n0 && !(is_a(a) && is_c2(b)) {
+            bonds.insert((a, b));
+        }
+    }
+    let mut goal_bonds = p.goal.bonds.clone();
+    for (a, b) in Scene::all_bonds(&goal_pos, &ext) {
+        if b >= n0 && !(is_a(a) && is_b2(b)) && !(a < 8 || (12..n0).contains(&a)) {
+            goal_bonds.insert((a, b));
+        }
+    }
+    p.start = Scene {
+        pos,
+        ext: ext.clone(),
+        bonds,
+    };
+    p.goal = Scene {
+        pos: goal_pos,
+        ext,
+        bonds: goal_bonds,
+    };
+    p.latchable.extend(n0..n0 + 8);
+    p.pinned.extend((n0..n0 + 8).flat_map(|a| [(a, 0), (a, 1)]));
+    p.faces = vec![Face::PosX, Face::NegX, Face::NegY, Face::PosY];
+    p
+}
+
 /// Lifts a 2D-slice scene and its steps to 3D: every atom becomes a
 /// column of two (z = 0 and z = one rest spacing up), attached to each
 /// other, and every operation is done by both atoms of the column (or, for
