@@ -50,6 +50,9 @@ enum Command {
     /// Draw the connector load map of a schedule's configuration at a step.
     #[cfg(feature = "render")]
     Loadmap(cli::pictures::LoadmapArgs),
+    /// Seed 004: SLIDE costs derived by search, and the 2D combing's
+    /// parallel steps and atom operations against n (log–log fits).
+    CombStudy(cli::comb::Args),
     /// Seed 003 §V-B1: active subtraction on random configurations of
     /// several densities; prints a table and draws a box plot.
     DensityStudy(cli::density::Args),
@@ -106,6 +109,7 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
         Command::Loadmap(a) => cli::pictures::loadmap(a),
         Command::DensityStudy(a) => cli::density::run(a),
         Command::DockingStudy(a) => cli::docking::run(a),
+        Command::CombStudy(a) => cli::comb::run(a),
         Command::Rules { json } => {
             let t = reconfcheck::geometry::table();
             print!("{}", t.to_text());

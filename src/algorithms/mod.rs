@@ -7,7 +7,9 @@
 //! `src/lib.rs`): a generator implements its paper, the certifier judges.
 
 pub mod active_subtraction;
+pub mod atom_moves;
 pub mod branch;
+pub mod comb;
 pub mod docking;
 pub mod random_walk;
 pub mod scaffold;
@@ -36,6 +38,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &branch::Branch,
         &scaffold::ScaffoldAssembly,
         &docking::Docking,
+        &comb::Comb2d,
     ]
 }
 

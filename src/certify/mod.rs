@@ -4,6 +4,7 @@
 //! Checks implement [`StepCheck`]; the lattice checks always run, geometric
 //! and mechanical checks join them where the lattice has a model for them.
 
+pub mod atom_check;
 pub(crate) mod baseline;
 pub(crate) mod collision_check;
 pub(crate) mod docking_check;
@@ -226,6 +227,13 @@ pub fn certify_by(
     opts: &Options,
     runner: &dyn RangeRunner,
 ) -> Result<Report, InputError> {
+    if let Some(rest) = schedule.atoms {
+        return atom_check::certify_atoms(schedule, rest, opts);
+    }
+    if let Some(rest) = schedule.meta_modules {
+        let atoms = crate::geometry::atom_expand::expand(schedule, rest)?;
+        return atom_check::certify_atoms(&atoms, rest, opts);
+    }
     let checks = checks_for(schedule, opts)?;
     let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
     let mut report = certify_on(schedule, opts, &refs, runner)?;

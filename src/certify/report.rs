@@ -44,6 +44,12 @@ pub enum ViolationKind {
     Unstable,
     /// A connector load exceeds its capacity.
     Overload,
+    /// Seed 004 atoms: the arms changing in one step disagree around a
+    /// cycle of attached faces (the step would tear the robot apart).
+    ArmConflict,
+    /// Seed 004 atoms: an atom leaves the union of the source's and the
+    /// target's bounding boxes (the paper's in-place claim).
+    OutOfPlace,
 }
 
 impl ViolationKind {

@@ -417,6 +417,12 @@ impl World {
                     plan.moving.insert(id);
                     plan.leaves.push(id);
                 }
+                Event::Expand { .. } | Event::Contract { .. } => {
+                    return Err(err(
+                        "expand/contract are atom operations: only a cubic schedule with `atoms` set has them"
+                            .into(),
+                    ));
+                }
                 Event::Attach { other, .. } | Event::Detach { other, .. } => {
                     self.require_present(id, step)?;
                     self.require_present(*other, step)?;

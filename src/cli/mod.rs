@@ -4,6 +4,7 @@
 //! and library results into files, text and exit codes.
 
 pub mod b_study;
+pub mod comb;
 pub mod density;
 pub mod docking;
 #[cfg(feature = "render")]

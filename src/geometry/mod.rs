@@ -4,6 +4,9 @@
 //! asks [`sweep_model`] for the one of the schedule's lattice and turns the
 //! contacts it reports into violations and warnings.
 
+pub mod atom;
+pub mod atom_expand;
+pub mod atom_search;
 pub(crate) mod catom;
 pub mod docking;
 pub(crate) mod fcc_sweep;

@@ -696,7 +696,10 @@ pub fn config_at_step(s: &Schedule, step: usize) -> Result<BTreeMap<u32, Cell>, 
                 Event::Leave { .. } => {
                     at.remove(&id).ok_or_else(unknown)?;
                 }
-                Event::Attach { .. } | Event::Detach { .. } => {}
+                Event::Attach { .. }
+                | Event::Detach { .. }
+                | Event::Expand { .. }
+                | Event::Contract { .. } => {}
             }
         }
     }

@@ -19,6 +19,80 @@ const DIRS: [Cell; 6] = [
     Cell::new(0, 0, -1),
 ];
 
+/// One face of a cubic atom, in connector order (`+x, +y, +z, −x, −y, −z`);
+/// written `"+x"` … `"-z"` in schedules.
+#[derive(
+    Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+pub enum Face {
+    #[serde(rename = "+x")]
+    PosX,
+    #[serde(rename = "+y")]
+    PosY,
+    #[serde(rename = "+z")]
+    PosZ,
+    #[serde(rename = "-x")]
+    NegX,
+    #[serde(rename = "-y")]
+    NegY,
+    #[serde(rename = "-z")]
+    NegZ,
+}
+
+impl Face {
+    pub const ALL: [Face; 6] = [
+        Face::PosX,
+        Face::PosY,
+        Face::PosZ,
+        Face::NegX,
+        Face::NegY,
+        Face::NegZ,
+    ];
+
+    /// The connector index (0..6) of this face.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The outward unit step of the face.
+    pub fn dir(self) -> Cell {
+        DIRS[self.index()]
+    }
+
+    /// The axis (0 x, 1 y, 2 z) the face is normal to.
+    pub fn axis(self) -> usize {
+        self.index() % 3
+    }
+
+    /// +1 for the positive faces, −1 for the negative ones.
+    pub fn sign(self) -> i32 {
+        if self.index() < 3 { 1 } else { -1 }
+    }
+
+    pub fn opposite(self) -> Face {
+        Face::ALL[(self.index() + 3) % 6]
+    }
+
+    /// The face normal to `axis` with `sign`.
+    pub fn of(axis: usize, sign: i32) -> Face {
+        Face::ALL[axis + if sign > 0 { 0 } else { 3 }]
+    }
+
+    pub fn name(self) -> &'static str {
+        ["+x", "+y", "+z", "-x", "-y", "-z"][self.index()]
+    }
+}
+
+/// How seed 004's atoms rest between moves: the paper's two models.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AtomRest {
+    /// Every face contracted: attached atoms are 1 unit apart.
+    Contracted,
+    /// Every face expanded: attached atoms are 3 units apart (body 1, two arms of 1).
+    Expanded,
+}
+
 /// The simple cubic lattice (unit spacing).
 #[derive(Copy, Clone, Debug, Default)]
 pub struct CubicLattice;

@@ -14,7 +14,7 @@ pub(crate) mod square;
 
 pub use cell::Cell;
 pub use config::{Configuration, Ground, ModuleId};
-pub use cubic::CubicLattice;
+pub use cubic::{AtomRest, CubicLattice, Face};
 pub use fcc::{FccLattice, directions as fcc_directions};
 pub use moves::{Motion, MoveError, MoveRequirements, Route};
 pub use square::SquareLattice;

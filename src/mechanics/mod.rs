@@ -17,6 +17,7 @@
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
 pub(crate) mod analysis;
+pub mod atom;
 pub(crate) mod capacity;
 pub(crate) mod closed_form;
 pub(crate) mod direct;

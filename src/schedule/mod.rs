@@ -8,7 +8,7 @@ pub(crate) mod units;
 
 use crate::error::InputError;
 use crate::lattice::config::{Ground, ModuleId};
-use crate::lattice::{Cell, LatticeKind, Route};
+use crate::lattice::{AtomRest, Cell, Face, LatticeKind, Route};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -35,6 +35,16 @@ pub struct Schedule {
     /// Path of the physical model (relative to the schedule file), if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<String>,
+    /// Cubic lattice only: the modules are seed 004's atoms, resting with
+    /// every face contracted or every face expanded, every pair of touching
+    /// faces attached (see `docs/schedule-format.md`, "Atoms").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atoms: Option<AtomRest>,
+    /// Cubic lattice only: the modules are seed 004's 2×2×2 meta-modules
+    /// of atoms resting in this model; the certifier expands every event
+    /// into atom operations (see `docs/atoms.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub meta_modules: Option<AtomRest>,
     /// The ground plane, if the scene has one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ground: Option<Ground>,
@@ -115,6 +125,12 @@ pub enum Event {
     Attach { module: ModuleId, other: ModuleId },
     /// Release the connectors between two neighbouring modules.
     Detach { module: ModuleId, other: ModuleId },
+    /// Cubic atom (seed 004): extend `face` by one unit, pushing whatever
+    /// is attached to it.
+    Expand { module: ModuleId, face: Face },
+    /// Cubic atom (seed 004): retract `face` by one unit, pulling whatever
+    /// is attached to it.
+    Contract { module: ModuleId, face: Face },
 }
 
 impl Event {
@@ -128,7 +144,9 @@ impl Event {
             | Event::Dock { module, .. }
             | Event::Leave { module }
             | Event::Attach { module, .. }
-            | Event::Detach { module, .. } => *module,
+            | Event::Detach { module, .. }
+            | Event::Expand { module, .. }
+            | Event::Contract { module, .. } => *module,
         }
     }
 
@@ -150,6 +168,8 @@ impl Schedule {
             lattice,
             spacing,
             model: None,
+            atoms: None,
+            meta_modules: None,
             ground: None,
             modules: Vec::new(),
             sources: Vec::new(),
@@ -205,6 +225,19 @@ impl Schedule {
     /// positive finite spacing (a normal number in metres), and cells within [`MAX_COORDINATE`].
     pub fn validate(&self) -> Result<(), InputError> {
         self.check_header()?;
+        if (self.atoms.is_some() || self.meta_modules.is_some())
+            && self.lattice != LatticeKind::Cubic
+        {
+            return Err(InputError::new(format!(
+                "`atoms` and `meta_modules` are for the cubic lattice only (this schedule is {})",
+                self.lattice.name()
+            )));
+        }
+        if self.atoms.is_some() && self.meta_modules.is_some() {
+            return Err(InputError::new(
+                "a schedule has `atoms` or `meta_modules`, not both",
+            ));
+        }
         // In metres, after the unit's factor: a value that over- or
         // underflows there (1e-320 mm) is no length either.
         if crate::number::positive(self.spacing.value)
@@ -259,7 +292,11 @@ impl Schedule {
                     Event::Tunnel { path, .. } => path.iter().collect(),
                     Event::Enter { cell, .. } => vec![cell],
                     Event::Dock { cell, from, .. } => vec![cell, from],
-                    Event::Leave { .. } | Event::Attach { .. } | Event::Detach { .. } => vec![],
+                    Event::Leave { .. }
+                    | Event::Attach { .. }
+                    | Event::Detach { .. }
+                    | Event::Expand { .. }
+                    | Event::Contract { .. } => vec![],
                 };
                 if let Some(c) = cells.into_iter().find(|c| far(c)) {
                     return Err(refuse(c).at_step(k + 1).for_module(e.module()));

@@ -3,6 +3,7 @@
 //! synthetic workloads for the benchmarks. Their pictures are drawn by [`crate::render`].
 
 pub mod b_study;
+pub mod comb;
 pub mod density;
 pub mod docking;
 pub mod scaffold_figures;

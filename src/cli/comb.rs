@@ -1,0 +1,109 @@
+//! `comb-study`: seed 004's move costs (SLIDE derived by search, per atom
+//! model and carried load) and the 2D combing's parallel steps and atom
+//! operations against n, with log–log fits, beside a naive baseline.
+
+use reconfcheck::algorithms::atom_moves::derive_slide;
+use reconfcheck::error::{Error, write_file};
+use reconfcheck::geometry::atom_search::Carry;
+use reconfcheck::lattice::AtomRest;
+use reconfcheck::study::comb as study;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Meta-module counts of the random polyominoes.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "8,16,32,64,128,256,512,1024,2048,4096"
+    )]
+    sizes: Vec<usize>,
+    #[arg(long, default_value_t = 4)]
+    seed: u64,
+    /// Certify the expanded schedules up to this many meta-modules.
+    #[arg(long, default_value_t = 4096)]
+    certify_up_to: usize,
+    /// Also write the rows as JSON.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> Result<u8, Error> {
+    println!("SLIDE derived by search (3D, 2×2×2 meta-modules); paper: O(1) steps and operations");
+    println!(
+        "{:<11} {:<18} {:>6} {:>6} {:>8}",
+        "model", "load", "steps", "ops", "states"
+    );
+    for rest in [AtomRest::Contracted, AtomRest::Expanded] {
+        for carry in Carry::ALL {
+            match derive_slide(rest, carry) {
+                Some(d) => println!(
+                    "{:<11} {:<18} {:>6} {:>6} {:>8}",
+                    format!("{rest:?}"),
+                    carry.name(),
+                    d.parallel_steps(),
+                    d.atom_operations(),
+                    d.found.states_explored
+                ),
+                None => println!("{:<11} {:<18} not found", format!("{rest:?}"), carry.name()),
+            }
+        }
+    }
+    println!("k-TUNNEL: not derived (see docs/atoms.md)");
+    let mut all = Vec::new();
+    // The expanded model has no derived SLIDE (docs/atoms.md).
+    for rest in [AtomRest::Contracted] {
+        let rows = study::run(&a.sizes, a.seed, rest, a.certify_up_to)?;
+        println!(
+            "\n2D COMBING, {rest:?} model (random polyominoes, seed {})",
+            a.seed
+        );
+        println!(
+            "{:>6} {:>7} {:>7} {:>8} {:>9} {:>10} {:>11} {:>8} {:>8} {:>9}",
+            "metas",
+            "atoms",
+            "mSteps",
+            "steps",
+            "ops",
+            "naiveStep",
+            "naiveOps",
+            "gen s",
+            "cert s",
+            "certified"
+        );
+        for r in &rows {
+            println!(
+                "{:>6} {:>7} {:>7} {:>8} {:>9} {:>10} {:>11} {:>8.3} {:>8} {:>9}",
+                r.metas,
+                r.atoms,
+                r.meta_steps,
+                r.steps,
+                r.operations,
+                r.baseline_steps,
+                r.baseline_operations,
+                r.generate_s,
+                r.certify_s.map_or("-".into(), |s| format!("{s:.2}")),
+                r.certified.map_or("-".into(), |c| c.to_string()),
+            );
+        }
+        let fit = |f: &dyn Fn(&study::Row) -> usize| {
+            let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.atoms as f64, f(r) as f64)).collect();
+            study::loglog_fit(&pts).map_or("-".to_string(), |(b, r2)| {
+                format!("slope {b:.3}, R² {r2:.3}")
+            })
+        };
+        println!("parallel steps vs n: {}", fit(&|r| r.steps));
+        println!("atom operations vs n: {}", fit(&|r| r.operations));
+        println!("naive steps vs n: {}", fit(&|r| r.baseline_steps));
+        println!("naive operations vs n: {}", fit(&|r| r.baseline_operations));
+        all.push((rest, rows));
+    }
+    if let Some(p) = &a.json {
+        let v: Vec<_> = all
+            .iter()
+            .map(|(rest, rows)| serde_json::json!({"model": format!("{rest:?}"), "rows": rows}))
+            .collect();
+        write_file(p, serde_json::to_string_pretty(&v).expect("serialises"))?;
+    }
+    Ok(0)
+}

@@ -1,0 +1,397 @@
+//! A `meta_modules` schedule (seed 004's 2×2×2 meta-modules on the cubic
+//! lattice) expanded into the atom operations that realise it, so that it
+//! is certified atom by atom and never on trust.
+//!
+//! * `slide` with a `pivot` (the wall B; C is the meta-module beside B in
+//!   the slide direction): the SLIDE that [`crate::geometry::atom_search`]
+//!   derives, turned to the move's direction and wall by the lattice
+//!   symmetry that maps the canonical slide (−x along a wall at −y) onto it.
+//!   Every slide of one meta-level step runs in lockstep.
+//! * `slide` without a `pivot`: a meta-module carried by a SLIDE of the
+//!   same step (it has no operations of its own; its atoms move because
+//!   they are attached to the slider's).
+//! * `attach`, `detach`: the four pairs of touching atoms of two
+//!   neighbouring meta-modules, in one step.
+//! * `tunnel`: refused — this build derives no k-TUNNEL (see
+//!   `docs/atoms.md`), and a tunnel is not taken on trust.
+//!
+//! Atom `8·id + i + 2j + 4k` is atom `(i, j, k)` of meta-module `id`.
+
+use super::atom_search::{Carry, Found, Op, Problem, lift, rest_spacing, slide_problem};
+use crate::error::InputError;
+use crate::lattice::config::ModuleId;
+use crate::lattice::{AtomRest, Cell, Face};
+use crate::schedule::{Event, ModuleSpec, Schedule, Step};
+use rustc_hash::FxHashMap;
+use std::sync::OnceLock;
+
+/// The SLIDE used for every slide: the 2D-slice search with both carried
+/// meta-modules present (valid, by construction, without them: they only
+/// add obstacles and never hold the robot together), lifted to 3D.
+pub struct SlideLibrary {
+    pub problem: Problem,
+    pub found: Found,
+    /// The lifted steps; atom `q` of the lifted scene is atom `(q / 2) % 4`
+    /// of the 2D slice's meta-module `q / 8`, at height `q % 2`.
+    pub steps: Vec<Vec<Op>>,
+}
+
+/// The SLIDE between two walls, searched once per process.
+pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
+    static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    let cell = match rest {
+        AtomRest::Contracted => &CONTRACTED,
+        AtomRest::Expanded => &EXPANDED,
+    };
+    cell.get_or_init(|| {
+        let problem = super::atom_search::double_slide_problem(rest);
+        let found = problem.solve()?;
+        let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+        Some(SlideLibrary {
+            problem,
+            found,
+            steps,
+        })
+    })
+    .as_ref()
+}
+
+/// The library of `rest`, searched once per process.
+pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
+    static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    let cell = match rest {
+        AtomRest::Contracted => &CONTRACTED,
+        AtomRest::Expanded => &EXPANDED,
+    };
+    cell.get_or_init(|| {
+        let (problem, _) = slide_problem(rest, Carry::Both);
+        let found = problem.solve()?;
+        let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+        Some(SlideLibrary {
+            problem,
+            found,
+            steps,
+        })
+    })
+    .as_ref()
+}
+
+/// A signed axis permutation (a lattice symmetry, mirror images included).
+#[derive(Copy, Clone, Debug)]
+struct Turn {
+    cols: [Cell; 3],
+}
+
+impl Turn {
+    /// Maps canonical −x to `d` (the slide) and −y to `w` (towards the wall).
+    fn new(d: Cell, w: Cell) -> Turn {
+        let ex = Cell::new(-d.x, -d.y, -d.z);
+        let ey = Cell::new(-w.x, -w.y, -w.z);
+        let u = Cell::new(
+            (ex.x == 0 && ey.x == 0) as i32,
+            (ex.y == 0 && ey.y == 0) as i32,
+            (ex.z == 0 && ey.z == 0) as i32,
+        );
+        Turn { cols: [ex, ey, u] }
+    }
+
+    fn apply(&self, v: Cell) -> Cell {
+        let [a, b, c] = self.cols;
+        Cell::new(
+            a.x * v.x + b.x * v.y + c.x * v.z,
+            a.y * v.x + b.y * v.y + c.y * v.z,
+            a.z * v.x + b.z * v.y + c.z * v.z,
+        )
+    }
+
+    /// The world local index of canonical local atom `(i, j, k)`.
+    fn local(&self, i: i32, j: i32, k: i32) -> u32 {
+        // Centred at the meta-module's middle: coordinates ±1.
+        let c = self.apply(Cell::new(2 * i - 1, 2 * j - 1, 2 * k - 1));
+        let b = |v: i32| ((v + 1) / 2) as u32;
+        b(c.x) + 2 * b(c.y) + 4 * b(c.z)
+    }
+
+    fn face(&self, f: Face) -> Face {
+        let v = self.apply(f.dir());
+        let (axis, sign) = if v.x != 0 {
+            (0, v.x)
+        } else if v.y != 0 {
+            (1, v.y)
+        } else {
+            (2, v.z)
+        };
+        Face::of(axis, sign)
+    }
+}
+
+/// The atoms of meta-module `id` at coarse cell `c`.
+fn atoms_of(id: ModuleId, c: Cell, sp: i32) -> impl Iterator<Item = ModuleSpec> {
+    (0..8u32).map(move |l| {
+        let (i, j, k) = ((l & 1) as i32, ((l >> 1) & 1) as i32, ((l >> 2) & 1) as i32);
+        ModuleSpec {
+            id: id * 8 + l,
+            cell: Cell::new((2 * c.x + i) * sp, (2 * c.y + j) * sp, (2 * c.z + k) * sp),
+            fixed: false,
+        }
+    })
+}
+
+/// The touching atom pairs of meta-modules `a` at `ca` and `b` at `cb`.
+fn face_pairs(a: ModuleId, ca: Cell, b: ModuleId, cb: Cell) -> Option<Vec<(ModuleId, ModuleId)>> {
+    let d = cb - ca;
+    if d.l1() != 1 {
+        return None;
+    }
+    let axis = if d.x != 0 {
+        0
+    } else if d.y != 0 {
+        1
+    } else {
+        2
+    };
+    let sign = d.x + d.y + d.z;
+    let bit = 1u32 << axis;
+    Some(
+        (0..8u32)
+            .filter(|l| (l & bit != 0) == (sign > 0))
+            .map(|l| (a * 8 + l, b * 8 + (l ^ bit)))
+            .collect(),
+    )
+}
+
+/// Expands a `meta_modules` schedule into an `atoms` schedule.
+pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
+    let sp = rest_spacing(rest);
+    let mut out = Schedule::new(s.lattice, s.spacing);
+    out.atoms = Some(rest);
+    out.model = s.model.clone();
+    out.meta = s.meta.clone();
+    out.meta
+        .insert("expanded_from".into(), "meta_modules".into());
+    let mut at: FxHashMap<ModuleId, Cell> = FxHashMap::default();
+    let mut by_cell: FxHashMap<Cell, ModuleId> = FxHashMap::default();
+    for m in &s.modules {
+        if m.id > u32::MAX / 8 - 1 {
+            return Err(
+                InputError::new("meta-module id too large to number its atoms").for_module(m.id),
+            );
+        }
+        if at.insert(m.id, m.cell).is_some() {
+            return Err(
+                InputError::new(format!("meta-module id {} is used twice", m.id)).for_module(m.id),
+            );
+        }
+        if by_cell.insert(m.cell, m.id).is_some() {
+            return Err(InputError::new(format!("two meta-modules at {}", m.cell)).for_module(m.id));
+        }
+        out.modules.extend(atoms_of(m.id, m.cell, sp).map(|mut a| {
+            a.fixed = m.fixed;
+            a
+        }));
+    }
+    for (k, step) in s.steps.iter().enumerate() {
+        let k1 = k + 1;
+        let mut latch: Vec<Event> = Vec::new();
+        let mut slides: Vec<Vec<Vec<Event>>> = Vec::new();
+        let mut moved: Vec<(ModuleId, Cell)> = Vec::new();
+        let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
+            FxHashMap::default();
+        for e in &step.events {
+            let id = e.module();
+            let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
+            let here = *at
+                .get(&id)
+                .ok_or_else(|| err(format!("meta-module {id} is not in the robot")))?;
+            match e {
+                Event::Attach { other, .. } | Event::Detach { other, .. } => {
+                    let there = *at
+                        .get(other)
+                        .ok_or_else(|| err(format!("meta-module {other} is not in the robot")))?;
+                    let pairs = face_pairs(id, here, *other, there).ok_or_else(|| {
+                        err(format!("meta-modules {id} and {other} are not neighbours"))
+                    })?;
+                    for (a, b) in pairs {
+                        latch.push(if matches!(e, Event::Attach { .. }) {
+                            Event::Attach {
+                                module: a,
+                                other: b,
+                            }
+                        } else {
+                            Event::Detach {
+                                module: a,
+                                other: b,
+                            }
+                        });
+                    }
+                }
+                Event::Slide {
+                    from, to, pivot, ..
+                } => {
+                    if *from != here {
+                        return Err(err(format!(
+                            "the slide starts at {from}, but the meta-module is at {here}"
+                        )));
+                    }
+                    let d = *to - *from;
+                    if d.l1() != 1 {
+                        return Err(err(format!("a SLIDE moves one cell, not {from} to {to}")));
+                    }
+                    if !moved.iter().any(|&(m, _)| m == id) {
+                        moved.push((id, *to));
+                    }
+                    let Some(b) = pivot else { continue };
+                    let cb = *at.get(b).ok_or_else(|| {
+                        err(format!("the wall meta-module {b} is not in the robot"))
+                    })?;
+                    let w = cb - here;
+                    if w.l1() != 1 || (w.x * d.x + w.y * d.y + w.z * d.z) != 0 {
+                        return Err(err(format!(
+                            "the wall meta-module {b} at {cb} is not beside the slider, across the slide"
+                        )));
+                    }
+                    let c = *by_cell.get(&(cb + d)).ok_or_else(|| {
+                        err(format!("SLIDE needs a meta-module at {} (beside the wall, in the slide direction)", cb + d))
+                    })?;
+                    walls.entry(id).or_default().push((d, w, *b, c));
+                }
+                Event::Tunnel { .. } => {
+                    return Err(err(
+                        "k-TUNNEL has no atom sequence in this build, and a tunnel is not certified on trust".into(),
+                    ));
+                }
+                _ => {
+                    return Err(err(
+                        "a meta-module schedule has slide, attach and detach events only".into(),
+                    ));
+                }
+            }
+        }
+        let mut ids_in_order: Vec<ModuleId> = walls.keys().copied().collect();
+        ids_in_order.sort_unstable();
+        for id in ids_in_order {
+            let ws = &walls[&id];
+            let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
+            let (lib, ids, (d, w)) = match ws.as_slice() {
+                [(d, w, b, c)] => {
+                    let lib = slide_library(rest).ok_or_else(|| {
+                        err("no atom sequence for SLIDE was found by the search".into())
+                    })?;
+                    (lib, vec![*b, *c, id], (*d, *w))
+                }
+                [(d, w, b, c), (d2, w2, b2, c2)] if d == d2 && *w2 == Cell::ZERO - *w => {
+                    let lib = double_slide_library(rest).ok_or_else(|| {
+                        err("no atom sequence for a SLIDE between two walls was found by the search".into())
+                    })?;
+                    (lib, vec![*b, *c, id, 0, 0, *b2, *c2], (*d, *w))
+                }
+                _ => {
+                    return Err(err(
+                        "a meta-module slides along one wall, or along two opposite walls in the same direction".into(),
+                    ));
+                }
+            };
+            let turn = Turn::new(d, w);
+            let atom = |q: usize| -> ModuleId {
+                let a2 = q / 2;
+                let meta = a2 / 4;
+                let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
+                ids[meta] * 8 + turn.local(i, j, (q % 2) as i32)
+            };
+            let steps: Vec<Vec<Event>> = lib
+                .steps
+                .iter()
+                .map(|st| {
+                    st.iter()
+                        .map(|op| match *op {
+                            Op::Expand(a, f) => Event::Expand {
+                                module: atom(a),
+                                face: turn.face(f),
+                            },
+                            Op::Contract(a, f) => Event::Contract {
+                                module: atom(a),
+                                face: turn.face(f),
+                            },
+                            Op::Attach(a, b) => Event::Attach {
+                                module: atom(a),
+                                other: atom(b),
+                            },
+                            Op::Detach(a, b) => Event::Detach {
+                                module: atom(a),
+                                other: atom(b),
+                            },
+                        })
+                        .collect()
+                })
+                .collect();
+            slides.push(steps);
+        }
+        if !latch.is_empty() {
+            out.steps.push(Step { events: latch });
+        }
+        let len = slides.iter().map(Vec::len).max().unwrap_or(0);
+        for t in 0..len {
+            let events: Vec<Event> = slides
+                .iter()
+                .filter_map(|sl| sl.get(t))
+                .flatten()
+                .cloned()
+                .collect();
+            out.steps.push(Step { events });
+        }
+        for &(id, _) in &moved {
+            by_cell.remove(&at[&id]);
+        }
+        for (id, to) in moved {
+            if let Some(o) = by_cell.insert(to, id) {
+                return Err(
+                    InputError::new(format!("meta-modules {o} and {id} both end at {to}"))
+                        .at_step(k1)
+                        .for_module(id),
+                );
+            }
+            at.insert(id, to);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_canonical_turn_is_the_identity_and_turns_are_bijections() {
+        let t = Turn::new(Cell::new(-1, 0, 0), Cell::new(0, -1, 0));
+        for l in 0..8 {
+            let (i, j, k) = (l & 1, (l >> 1) & 1, (l >> 2) & 1);
+            assert_eq!(t.local(i, j, k), l as u32);
+        }
+        for f in Face::ALL {
+            assert_eq!(t.face(f), f);
+        }
+        // Slide down along a wall on the left, and its mirror image.
+        for w in [Cell::new(-1, 0, 0), Cell::new(1, 0, 0)] {
+            let t = Turn::new(Cell::new(0, -1, 0), w);
+            let mut seen: Vec<u32> = (0..8)
+                .map(|l| t.local(l & 1, (l >> 1) & 1, (l >> 2) & 1))
+                .collect();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..8).collect::<Vec<_>>());
+            assert_eq!(t.face(Face::NegX), Face::NegY);
+            assert_eq!(
+                t.face(Face::NegY),
+                if w.x < 0 { Face::NegX } else { Face::PosX }
+            );
+        }
+    }
+
+    #[test]
+    fn neighbouring_meta_modules_touch_through_four_atom_pairs() {
+        let p = face_pairs(0, Cell::new(0, 0, 0), 1, Cell::new(1, 0, 0)).unwrap();
+        assert_eq!(p, vec![(1, 8), (3, 10), (5, 12), (7, 14)]);
+        assert!(face_pairs(0, Cell::new(0, 0, 0), 1, Cell::new(1, 1, 0)).is_none());
+    }
+}

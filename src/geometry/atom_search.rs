@@ -1,0 +1,546 @@
+//! Search over atom states for sequences of atom operations that realise a
+//! meta-module move (seed 004's SLIDE), with the kinematics and the
+//! collision and connectivity rules of [`crate::geometry::atom`].
+//!
+//! The search is breadth-first over single operations, so it finds a
+//! sequence with the fewest atom operations the rules allow; the sequence
+//! is then packed greedily into parallel steps: an operation joins the
+//! current step when doing it at the same time as the step's others is a
+//! valid step ending in the same state. The packed sequence is what
+//! schedules carry and what the certifier checks independently.
+
+use super::atom::{Bond, Faces, atom_boxes, contact_face, first_overlap, solve_step};
+use crate::lattice::{Cell, Face};
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::collections::{BTreeSet, VecDeque};
+
+/// One atom operation, on atoms numbered within a [`Scene`].
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Op {
+    Expand(usize, Face),
+    Contract(usize, Face),
+    Attach(usize, usize),
+    Detach(usize, usize),
+}
+
+impl Op {
+    /// The atoms the operation names.
+    pub fn atoms(&self) -> (usize, Option<usize>) {
+        match *self {
+            Op::Expand(a, _) | Op::Contract(a, _) => (a, None),
+            Op::Attach(a, b) | Op::Detach(a, b) => (a, Some(b)),
+        }
+    }
+}
+
+/// Atoms with positions, faces and bonds; the anchors hold the frame.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Scene {
+    pub pos: Vec<Cell>,
+    pub ext: Vec<Faces>,
+    /// Attached pairs `(a, b)`, `a < b`.
+    pub bonds: BTreeSet<(usize, usize)>,
+}
+
+fn pair(a: usize, b: usize) -> (usize, usize) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+impl Scene {
+    /// Every touching pair attached.
+    pub fn all_bonds(pos: &[Cell], ext: &[Faces]) -> BTreeSet<(usize, usize)> {
+        let mut out = BTreeSet::new();
+        for a in 0..pos.len() {
+            for b in a + 1..pos.len() {
+                if contact_face(pos[a], &ext[a], pos[b], &ext[b]).is_some() {
+                    out.insert((a, b));
+                }
+            }
+        }
+        out
+    }
+
+    fn bond_list(&self) -> Vec<Bond> {
+        self.bonds
+            .iter()
+            .map(|&(a, b)| Bond {
+                a,
+                face: contact_face(self.pos[a], &self.ext[a], self.pos[b], &self.ext[b])
+                    .expect("bonded atoms touch"),
+                b,
+            })
+            .collect()
+    }
+
+    fn connected(&self, bonds: &BTreeSet<(usize, usize)>) -> bool {
+        let n = self.pos.len();
+        let mut adj = vec![Vec::new(); n];
+        for &(a, b) in bonds {
+            adj[a].push(b);
+            adj[b].push(a);
+        }
+        let mut seen = vec![false; n];
+        let mut stack = vec![0];
+        seen[0] = true;
+        while let Some(u) = stack.pop() {
+            for &v in &adj[u] {
+                if !seen[v] {
+                    seen[v] = true;
+                    stack.push(v);
+                }
+            }
+        }
+        seen.iter().all(|&s| s)
+    }
+
+    /// Does `ops` as one parallel step: `None` when it is not a valid step
+    /// (a face operation that does not apply, an attach of faces that do
+    /// not touch at the end, a detach of an unattached pair, arms that
+    /// disagree, a disconnected robot, a collision deeper than `eps`).
+    pub fn step(&self, ops: &[Op], anchors: &[usize], eps: f64) -> Option<Scene> {
+        let mut ext1 = self.ext.clone();
+        let mut held = self.bonds.clone();
+        let mut attach = Vec::new();
+        let mut faces_seen = FxHashSet::default();
+        for op in ops {
+            match *op {
+                Op::Expand(a, f) | Op::Contract(a, f) => {
+                    let want = matches!(op, Op::Expand(..));
+                    if ext1[a][f.index()] == want || !faces_seen.insert((a, f)) {
+                        return None;
+                    }
+                    ext1[a][f.index()] = want;
+                }
+                Op::Detach(a, b) => {
+                    if !held.remove(&pair(a, b)) {
+                        return None;
+                    }
+                }
+                Op::Attach(a, b) => {
+                    if self.bonds.contains(&pair(a, b)) {
+                        return None;
+                    }
+                    attach.push(pair(a, b));
+                }
+            }
+        }
+        if !self.connected(&held) {
+            return None;
+        }
+        let kept = Scene {
+            pos: self.pos.clone(),
+            ext: self.ext.clone(),
+            bonds: held.clone(),
+        };
+        let end = solve_step(&self.pos, &ext1, &kept.bond_list(), anchors).ok()?;
+        // Collisions of everything that moves or changes an arm.
+        let active: Vec<usize> = (0..self.pos.len())
+            .filter(|&a| end[a] != self.pos[a] || ext1[a] != self.ext[a])
+            .collect();
+        let boxes: Vec<_> = (0..self.pos.len())
+            .map(|a| atom_boxes(self.pos[a], end[a], &self.ext[a], &ext1[a]))
+            .collect();
+        for &a in &active {
+            for b in 0..self.pos.len() {
+                if b == a || (b < a && active.contains(&b)) {
+                    continue;
+                }
+                for (_, x) in &boxes[a] {
+                    for (_, y) in &boxes[b] {
+                        if first_overlap(x, y, eps).is_some() {
+                            return None;
+                        }
+                    }
+                }
+            }
+        }
+        for (a, b) in attach {
+            contact_face(end[a], &ext1[a], end[b], &ext1[b])?;
+            held.insert((a, b));
+        }
+        Some(Scene {
+            pos: end,
+            ext: ext1,
+            bonds: held,
+        })
+    }
+}
+
+/// What the search may do and where it must end.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    pub start: Scene,
+    pub goal: Scene,
+    /// Atoms that may expand and contract, and attach or detach.
+    pub actors: Vec<usize>,
+    /// Faces the actors may use.
+    pub faces: Vec<Face>,
+    /// Atoms the actors may attach to or detach from (actors included).
+    pub latchable: Vec<usize>,
+    /// Atoms that must keep one coordinate (axis 0–2) all along.
+    pub pinned: Vec<(usize, usize)>,
+    pub anchors: Vec<usize>,
+    /// Largest distance (L∞, in atom lengths) an atom may stray from both
+    /// its start and its goal position: keeps the state space finite.
+    pub reach: i32,
+    /// Search no deeper (atom operations).
+    pub max_ops: usize,
+    pub eps: f64,
+}
+
+/// A found sequence: single operations in order, and packed into steps.
+#[derive(Clone, Debug)]
+pub struct Found {
+    pub ops: Vec<Op>,
+    pub steps: Vec<Vec<Op>>,
+    pub states_explored: usize,
+}
+
+impl Problem {
+    fn candidate_ops(&self, s: &Scene) -> Vec<Op> {
+        let mut out = Vec::new();
+        let is_actor: FxHashSet<usize> = self.actors.iter().copied().collect();
+        for &a in &self.actors {
+            for &f in &self.faces {
+                out.push(if s.ext[a][f.index()] {
+                    Op::Contract(a, f)
+                } else {
+                    Op::Expand(a, f)
+                });
+            }
+        }
+        let latchable: FxHashSet<usize> = self.latchable.iter().copied().collect();
+        for &(a, b) in &s.bonds {
+            if (is_actor.contains(&a) || is_actor.contains(&b))
+                && latchable.contains(&a)
+                && latchable.contains(&b)
+            {
+                out.push(Op::Detach(a, b));
+            }
+        }
+        for &a in &self.actors {
+            for b in 0..s.pos.len() {
+                if a != b
+                    && latchable.contains(&b)
+                    && !(is_actor.contains(&b) && b < a)
+                    && !s.bonds.contains(&pair(a, b))
+                    && contact_face(s.pos[a], &s.ext[a], s.pos[b], &s.ext[b]).is_some()
+                {
+                    out.push(Op::Attach(pair(a, b).0, pair(a, b).1));
+                }
+            }
+        }
+        out
+    }
+
+    fn within_reach(&self, s: &Scene) -> bool {
+        let axis = |c: Cell, i: usize| [c.x, c.y, c.z][i];
+        if self
+            .pinned
+            .iter()
+            .any(|&(a, i)| axis(s.pos[a], i) != axis(self.start.pos[a], i))
+        {
+            return false;
+        }
+        s.pos.iter().enumerate().all(|(a, p)| {
+            let d0 = (*p - self.start.pos[a]).linf();
+            let d1 = (*p - self.goal.pos[a]).linf();
+            d0.min(d1) <= self.reach && d0.max(d1) <= 2 * self.reach
+        })
+    }
+
+    /// Breadth-first search; `None` when no sequence of at most `max_ops`
+    /// operations exists within the reach.
+    pub fn solve(&self) -> Option<Found> {
+        let mut parent: FxHashMap<Scene, Option<(Scene, Op)>> = FxHashMap::default();
+        parent.insert(self.start.clone(), None);
+        let mut frontier = VecDeque::from([(self.start.clone(), 0usize)]);
+        while let Some((s, depth)) = frontier.pop_front() {
+            if s == self.goal {
+                let mut ops = Vec::new();
+                let mut cur = s;
+                while let Some(Some((prev, op))) = parent.get(&cur).cloned() {
+                    ops.push(op);
+                    cur = prev;
+                }
+                ops.reverse();
+                let steps = self.pack(&ops);
+                return Some(Found {
+                    ops,
+                    steps,
+                    states_explored: parent.len(),
+                });
+            }
+            if depth >= self.max_ops {
+                continue;
+            }
+            for op in self.candidate_ops(&s) {
+                let Some(next) = s.step(&[op], &self.anchors, self.eps) else {
+                    continue;
+                };
+                if !self.within_reach(&next) || parent.contains_key(&next) {
+                    continue;
+                }
+                parent.insert(next.clone(), Some((s.clone(), op)));
+                frontier.push_back((next, depth + 1));
+            }
+        }
+        None
+    }
+
+    /// Packs a sequence into parallel steps greedily (see the module doc).
+    pub fn pack(&self, ops: &[Op]) -> Vec<Vec<Op>> {
+        pack(&self.start, ops, &self.anchors, self.eps)
+    }
+}
+
+/// Packs `ops`, valid one at a time from `start`, into parallel steps.
+pub fn pack(start: &Scene, ops: &[Op], anchors: &[usize], eps: f64) -> Vec<Vec<Op>> {
+    let mut steps: Vec<Vec<Op>> = Vec::new();
+    let mut before = start.clone();
+    let mut group: Vec<Op> = Vec::new();
+    let mut after = start.clone();
+    for &op in ops {
+        let seq = after
+            .step(&[op], anchors, eps)
+            .expect("the sequence is valid one operation at a time");
+        let mut joined = group.clone();
+        joined.push(op);
+        if !group.is_empty() && before.step(&joined, anchors, eps).as_ref() == Some(&seq) {
+            group = joined;
+        } else {
+            if !group.is_empty() {
+                steps.push(std::mem::take(&mut group));
+                before = after.clone();
+            }
+            group.push(op);
+        }
+        after = seq;
+    }
+    if !group.is_empty() {
+        steps.push(group);
+    }
+    steps
+}
+
+/// Meta-modules carried by the slider (SLIDE with carried meta-modules,
+/// seed 004 Fig. 1b–c).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Carry {
+    /// The slider alone.
+    None,
+    /// One meta-module behind the slider (on the side it leaves).
+    Behind,
+    /// One meta-module on the slider's far side from the wall.
+    Above,
+    /// Both.
+    Both,
+}
+
+impl Carry {
+    pub const ALL: [Carry; 4] = [Carry::None, Carry::Behind, Carry::Above, Carry::Both];
+    pub fn name(self) -> &'static str {
+        match self {
+            Carry::None => "alone",
+            Carry::Behind => "carrying 1 behind",
+            Carry::Above => "carrying 1 above",
+            Carry::Both => "carrying 2",
+        }
+    }
+}
+
+/// Centre distance of two attached atoms at rest.
+pub fn rest_spacing(rest: crate::lattice::AtomRest) -> i32 {
+    match rest {
+        crate::lattice::AtomRest::Contracted => 1,
+        crate::lattice::AtomRest::Expanded => 1 + 2 * super::atom::ARM,
+    }
+}
+
+/// The atoms of meta-module cell `(mx, my)` in a 2D slice (`z = 0`),
+/// in the order (0,0), (1,0), (0,1), (1,1).
+pub fn meta_atoms_2d(mx: i32, my: i32, sp: i32) -> [Cell; 4] {
+    [(0, 0), (1, 0), (0, 1), (1, 1)]
+        .map(|(i, j)| Cell::new((2 * mx + i) * sp, (2 * my + j) * sp, 0))
+}
+
+/// The labelled scene of a SLIDE in a 2D slice: the slider A at meta cell
+/// (1, 1) slides −x along the wall B (1, 0) onto C (0, 0). Carried
+/// meta-modules: D behind A (2, 1), E on A's far side from the wall
+/// (1, 2); they stay attached to A and may move only along the slide. A
+/// static meta-module F (−1, 1) stands ahead of A's goal (held by H
+/// (−1, 0) beside C), so that the move needs no room beyond the goal.
+/// Only A's atoms act, with their faces ±x and −y (never towards the far
+/// side, where a stationary neighbour may stand), latching only to A, B
+/// and C. Atom order: B, C, A, F, H, then D and E as carried. Returns the
+/// problem and, for each atom, its meta-module's label.
+pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, Vec<char>) {
+    let sp = rest_spacing(rest);
+    let mut metas: Vec<(char, (i32, i32), (i32, i32))> = vec![
+        ('B', (1, 0), (1, 0)),
+        ('C', (0, 0), (0, 0)),
+        ('A', (1, 1), (0, 1)),
+        ('F', (-1, 1), (-1, 1)),
+        ('H', (-1, 0), (-1, 0)),
+    ];
+    if matches!(carry, Carry::Behind | Carry::Both) {
+        metas.push(('D', (2, 1), (1, 1)));
+    }
+    if matches!(carry, Carry::Above | Carry::Both) {
+        metas.push(('E', (1, 2), (0, 2)));
+    }
+    let mut pos = Vec::new();
+    let mut goal_pos = Vec::new();
+    let mut label = Vec::new();
+    for &(l, from, to) in &metas {
+        pos.extend(meta_atoms_2d(from.0, from.1, sp));
+        goal_pos.extend(meta_atoms_2d(to.0, to.1, sp));
+        label.extend([l; 4]);
+    }
+    let faces = [rest == crate::lattice::AtomRest::Expanded; 6];
+    let ext = vec![faces; pos.len()];
+    let is = |a: usize, l: char| label[a] == l;
+    let between =
+        |a: usize, b: usize, x: char, y: char| (is(a, x) && is(b, y)) || (is(a, y) && is(b, x));
+    // At rest every touching pair is attached, except that F touches A
+    // only at the goal and is not attached to it.
+    let bonds: BTreeSet<(usize, usize)> = Scene::all_bonds(&pos, &ext)
+        .into_iter()
+        .filter(|&(a, b)| !between(a, b, 'A', 'F'))
+        .collect();
+    let start = Scene {
+        pos,
+        ext: ext.clone(),
+        bonds: bonds.clone(),
+    };
+    let touching = Scene::all_bonds(&goal_pos, &ext);
+    let mut goal_bonds: BTreeSet<(usize, usize)> = bonds
+        .iter()
+        .copied()
+        .filter(|&(a, b)| !between(a, b, 'A', 'B'))
+        .collect();
+    for &(a, b) in &touching {
+        if between(a, b, 'A', 'C') {
+            goal_bonds.insert((a, b));
+        }
+    }
+    let goal = Scene {
+        pos: goal_pos,
+        ext,
+        bonds: goal_bonds,
+    };
+    let n = label.len();
+    let actors = (0..n).filter(|&a| is(a, 'A')).collect();
+    let latchable = (0..n)
+        .filter(|&a| is(a, 'A') || is(a, 'B') || is(a, 'C'))
+        .collect();
+    let pinned = (0..n)
+        .filter(|&a| is(a, 'D') || is(a, 'E'))
+        .map(|a| (a, 1))
+        .collect();
+    let problem = Problem {
+        start,
+        goal,
+        actors,
+        faces: vec![Face::PosX, Face::NegX, Face::NegY],
+        latchable,
+        pinned,
+        anchors: vec![0],
+        reach: 2 * sp + 1,
+        max_ops: 60,
+        eps: 1e-6,
+    };
+    (problem, label)
+}
+
+/// The SLIDE of a lone meta-module between two walls (seed 004 Alg. 1: a
+/// moving wall component of one meta-module with stationary neighbours on
+/// both sides slides along both, so that the robot stays connected through
+/// it). The scene of [`slide_problem`] without carried meta-modules, plus
+/// a second wall B′ (1, 2) and C′ (0, 2) on A's far side, which must not
+/// move (they may hang on A alone). Atom order: B, C, A, F, H, B′, C′.
+pub fn double_slide_problem(rest: crate::lattice::AtomRest) -> Problem {
+    let (mut p, _) = slide_problem(rest, Carry::None);
+    let sp = rest_spacing(rest);
+    let n0 = p.start.pos.len();
+    let mut pos = p.start.pos.clone();
+    pos.extend(meta_atoms_2d(1, 2, sp));
+    pos.extend(meta_atoms_2d(0, 2, sp));
+    let mut goal_pos = p.goal.pos.clone();
+    goal_pos.extend(meta_atoms_2d(1, 2, sp));
+    goal_pos.extend(meta_atoms_2d(0, 2, sp));
+    let ext = vec![p.start.ext[0]; pos.len()];
+    let is_a = |a: usize| (8..12).contains(&a);
+    let is_b2 = |a: usize| (n0..n0 + 4).contains(&a);
+    let is_c2 = |a: usize| (n0 + 4..n0 + 8).contains(&a);
+    let mut bonds = p.start.bonds.clone();
+    for (a, b) in Scene::all_bonds(&pos, &ext) {
+        if b >= n0 && !(is_a(a) && is_c2(b)) {
+            bonds.insert((a, b));
+        }
+    }
+    let mut goal_bonds = p.goal.bonds.clone();
+    for (a, b) in Scene::all_bonds(&goal_pos, &ext) {
+        if b >= n0 && !(is_a(a) && is_b2(b)) && !(a < 8 || (12..n0).contains(&a)) {
+            goal_bonds.insert((a, b));
+        }
+    }
+    p.start = Scene {
+        pos,
+        ext: ext.clone(),
+        bonds,
+    };
+    p.goal = Scene {
+        pos: goal_pos,
+        ext,
+        bonds: goal_bonds,
+    };
+    p.latchable.extend(n0..n0 + 8);
+    p.pinned.extend((n0..n0 + 8).flat_map(|a| [(a, 0), (a, 1)]));
+    p.faces = vec![Face::PosX, Face::NegX, Face::NegY, Face::PosY];
+    p
+}
+
+/// Lifts a 2D-slice scene and its steps to 3D: every atom becomes a
+/// column of two (z = 0 and z = one rest spacing up), attached to each
+/// other, and every operation is done by both atoms of the column (or, for
+/// a latch, both pairs) in the same step. Atom `a` of the slice becomes
+/// atoms `2a` (bottom) and `2a + 1` (top).
+pub fn lift(scene: &Scene, steps: &[Vec<Op>], sp: i32) -> (Scene, Vec<Vec<Op>>) {
+    let mut pos = Vec::new();
+    let mut ext = Vec::new();
+    for (a, p) in scene.pos.iter().enumerate() {
+        for z in [0, sp] {
+            pos.push(Cell::new(p.x, p.y, z));
+            let mut e = scene.ext[a];
+            // The vertical faces rest like the others.
+            e[Face::PosZ.index()] = sp > 1;
+            e[Face::NegZ.index()] = sp > 1;
+            ext.push(e);
+        }
+    }
+    let mut bonds = BTreeSet::new();
+    for (a, b) in &scene.bonds {
+        bonds.insert((2 * a, 2 * b));
+        bonds.insert((2 * a + 1, 2 * b + 1));
+    }
+    for a in 0..scene.pos.len() {
+        bonds.insert((2 * a, 2 * a + 1));
+    }
+    let lifted = steps
+        .iter()
+        .map(|st| {
+            st.iter()
+                .flat_map(|op| {
+                    (0..2).map(move |z| match *op {
+                        Op::Expand(a, f) => Op::Expand(2 * a + z, f),
+                        Op::Contract(a, f) => Op::Contract(2 * a + z, f),
+                        Op::Attach(a, b) => Op::Attach(2 * a + z, 2 * b + z),
+                        Op::Detach(a, b) => Op::Detach(2 * a + z, 2 * b + z),
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    (Scene { pos, ext, bonds }, lifted)
+}
