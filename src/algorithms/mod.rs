@@ -9,6 +9,7 @@
 pub mod active_subtraction;
 pub mod branch;
 pub mod random_walk;
+pub mod repost;
 pub mod scaffold;
 pub mod schedule_file;
 
@@ -34,6 +35,8 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &active_subtraction::ActiveSubtraction,
         &branch::Branch,
         &scaffold::ScaffoldAssembly,
+        &repost::RepostOperation,
+        &repost::Repost,
     ]
 }
 
