@@ -80,8 +80,7 @@ pub fn operation_schedule(plan: &OperationPlan, spacing_mm: f64) -> Schedule {
     }
     let sc = &plan.scene;
     s.meta.insert("algorithm".into(), "repost-operation".into());
-    s.meta
-        .insert("direction".into(), sc.dir.name().into());
+    s.meta.insert("direction".into(), sc.dir.name().into());
     s.meta.insert(
         "assemble".into(),
         match sc.fill {
@@ -199,7 +198,9 @@ impl Generator for Repost {
             .expect("the FCC lattice has derived motion rules");
         let plan = planner::plan(&initial, &goal, rules).map_err(|e| {
             let file = match e {
-                planner::PlanError::Bound { .. } | planner::PlanError::Unreachable(_) | planner::PlanError::Stuck(..) => &gp,
+                planner::PlanError::Bound { .. }
+                | planner::PlanError::Unreachable(_)
+                | planner::PlanError::Stuck(..) => &gp,
                 planner::PlanError::NoCoordinator => &ip,
             };
             InputError::new(e.to_string()).in_file(file)

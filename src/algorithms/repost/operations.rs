@@ -300,7 +300,9 @@ fn plan(scene: &OperationScene, order: &[Cell], strict: bool) -> Result<Operatio
         let (Some(first), Some(last)) = (path.first(), path.last()) else {
             continue;
         };
-        let m = at.remove(&first.from).expect("the mover is in its start cell");
+        let m = at
+            .remove(&first.from)
+            .expect("the mover is in its start cell");
         for h in &path {
             let pivot = at[&h.pivot];
             rotations.push(Rotation {

@@ -57,7 +57,10 @@ impl std::fmt::Display for PlanError {
             ),
             PlanError::NoCoordinator => write!(f, "no meta-module is in both shapes"),
             PlanError::Unreachable(m) => {
-                write!(f, "goal meta-module {m} cannot be reached by any streamline")
+                write!(
+                    f,
+                    "goal meta-module {m} cannot be reached by any streamline"
+                )
             }
             PlanError::Stuck(m, c) => write!(
                 f,
@@ -142,8 +145,16 @@ pub fn plan(
         ..Default::default()
     };
     loop {
-        let empty: Vec<Meta> = goal.iter().filter(|m| !state.contains_key(m)).copied().collect();
-        let extra: Vec<Meta> = state.keys().filter(|m| !goal.contains(m)).copied().collect();
+        let empty: Vec<Meta> = goal
+            .iter()
+            .filter(|m| !state.contains_key(m))
+            .copied()
+            .collect();
+        let extra: Vec<Meta> = state
+            .keys()
+            .filter(|m| !goal.contains(m))
+            .copied()
+            .collect();
         if empty.is_empty() && extra.is_empty() {
             return Ok(out);
         }
@@ -180,11 +191,16 @@ pub fn plan(
         // 3. Streamlines by max-flow with unit vertex capacities.
         let streamlines = streamlines(&state, &sources, &destinations);
         if streamlines.is_empty() {
-            let m = empty_sorted.first().or(extra.first()).copied().unwrap_or(gc);
+            let m = empty_sorted
+                .first()
+                .or(extra.first())
+                .copied()
+                .unwrap_or(gc);
             return Err(PlanError::Unreachable(m));
         }
         // 4. Transport.
         let first_step = out.steps.len();
+        let before = scene.clone();
         let mut lanes: Vec<Vec<(Cell, Hop)>> = Vec::new();
         let mut goals: Vec<Meta> = Vec::new();
         for line in &streamlines {
@@ -194,23 +210,42 @@ pub fn plan(
                 .find(|(d, _)| *d == dst)
                 .map(|(_, e)| *e)
                 .expect("a destination has its goal cell");
-            let mut reg: FxHashSet<Cell> = FxHashSet::default();
-            for m in line.iter().chain([&goal_meta]) {
-                reg.extend(region(*m));
-            }
-            let mut s = scene.clone();
-            s.region = Some(reg);
             let from = src.sparse_cells();
             let targets = goal_meta.sparse_cells();
-            let paths = move_catoms(&mut s, &from, &targets, true)
-                .or_else(|_| {
-                    let mut s2 = scene.clone();
-                    s2.region = s.region.clone();
-                    let r = move_catoms(&mut s2, &from, &targets, false);
-                    s = s2;
-                    r
-                })
-                .map_err(|c| PlanError::Stuck(goal_meta, c))?;
+            // Inside the streamline's boxes first, then with one cell of
+            // margin; strictly (no sliding contact) first in each.
+            let mut found = None;
+            let mut last = targets[0];
+            'tries: for margin in [0, 1] {
+                let mut reg: FxHashSet<Cell> = FxHashSet::default();
+                for m in line.iter().chain([&goal_meta]) {
+                    for c in region(*m) {
+                        for dx in -margin..=margin {
+                            for dy in -margin..=margin {
+                                reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
+                            }
+                        }
+                    }
+                }
+                for strict in [true, false] {
+                    let mut s = scene.clone();
+                    s.region = Some(reg.clone());
+                    match move_catoms(&mut s, &from, &targets, strict) {
+                        Ok(p) => {
+                            found = Some(p);
+                            break 'tries;
+                        }
+                        Err(c) => last = c,
+                    }
+                }
+            }
+            let paths = found.ok_or(PlanError::Stuck(goal_meta, last))?;
+            // The next streamline plans against this one's end state.
+            for p in &paths {
+                let (a, b) = (p[0].from, p[p.len() - 1].to);
+                let id = scene.at.remove(&a).expect("mover in place");
+                scene.insert(id, b);
+            }
             let mut lane = Vec::new();
             for p in paths {
                 let start = p[0].from;
@@ -224,6 +259,7 @@ pub fn plan(
             state.insert(goal_meta, State::Sparse);
         }
         let motions: usize = lanes.iter().map(Vec::len).sum();
+        scene = before;
         merge_lanes(&mut scene, lanes, rules, &mut out)
             .map_err(|(i, c)| PlanError::Stuck(goals[i], c))?;
         out.iterations.push(Iteration {
@@ -325,7 +361,9 @@ fn merge_lanes(
     // Where each lane's current mover is, by its start cell.
     let mut cur: Vec<Option<Cell>> = vec![None; lanes.len()];
     loop {
-        let live: Vec<usize> = (0..lanes.len()).filter(|&i| pos[i] < lanes[i].len()).collect();
+        let live: Vec<usize> = (0..lanes.len())
+            .filter(|&i| pos[i] < lanes[i].len())
+            .collect();
         if live.is_empty() {
             break;
         }

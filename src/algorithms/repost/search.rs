@@ -6,9 +6,9 @@
 //! the search does), and whose two sliding contacts never pinch it. In the
 //! strict mode no hop even touches a module other than its pivot.
 
+use crate::geometry::ContactKind;
 use crate::geometry::rolling::{Link, Roll, links};
 use crate::geometry::rules::table;
-use crate::geometry::ContactKind;
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, FccLattice, Lattice, Route, fcc};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -42,7 +42,12 @@ fn links_from() -> &'static [Vec<Link>; 12] {
     static T: OnceLock<[Vec<Link>; 12]> = OnceLock::new();
     T.get_or_init(|| {
         let all = links();
-        std::array::from_fn(|f| all.iter().copied().filter(|l| l.from as usize == f).collect())
+        std::array::from_fn(|f| {
+            all.iter()
+                .copied()
+                .filter(|l| l.from as usize == f)
+                .collect()
+        })
     })
 }
 

@@ -93,12 +93,21 @@ mod tests {
 
     #[test]
     fn leaders_round_trip_and_other_cells_are_refused() {
-        for m in [Meta::new(0, 0, 0), Meta::new(-2, 3, 1), Meta::new(1, -1, -1)] {
+        for m in [
+            Meta::new(0, 0, 0),
+            Meta::new(-2, 3, 1),
+            Meta::new(1, -1, -1),
+        ] {
             assert_eq!(meta_of_leader(m.leader()), Some(m));
         }
         assert_eq!(meta_of_leader(Cell::new(1, 0, 0)), None);
         assert_eq!(meta_of_leader(Cell::new(0, 0, 4)), None); // Z odd: y = −1
-        let e = parse("0 0 0\n4 1 0\n", Path::new("s.txt")).unwrap_err().to_string();
-        assert!(e.contains("s.txt") && e.contains("line 2") && e.contains("(4, 1, 0)"), "{e}");
+        let e = parse("0 0 0\n4 1 0\n", Path::new("s.txt"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("s.txt") && e.contains("line 2") && e.contains("(4, 1, 0)"),
+            "{e}"
+        );
     }
 }
