@@ -176,7 +176,19 @@ pub fn plan(
             .copied()
             .collect();
         // 2. Destinations: one per empty goal cell, lowest cells first.
-        let mut empty_sorted = empty.clone();
+        // Built bottom-up: a goal cell whose cell below is empty waits
+        // (a meta-module would otherwise hang from its destination).
+        let low = goal.iter().map(|m| m.z).min().unwrap_or(0);
+        let mut empty_sorted: Vec<Meta> = empty
+            .iter()
+            .filter(|m| {
+                m.z == low || state.contains_key(&m.step(super::metamodule::Direction::Down))
+            })
+            .copied()
+            .collect();
+        if empty_sorted.is_empty() {
+            empty_sorted = empty.clone();
+        }
         empty_sorted.sort_by_key(|m| (m.z, m.x, m.y));
         let mut taken: FxHashSet<Meta> = FxHashSet::default();
         let mut destinations: Vec<(Meta, Meta)> = Vec::new();
@@ -259,9 +271,19 @@ pub fn plan(
             state.insert(goal_meta, State::Sparse);
         }
         let motions: usize = lanes.iter().map(Vec::len).sum();
-        scene = before;
-        merge_lanes(&mut scene, lanes, rules, &mut out)
-            .map_err(|(i, c)| PlanError::Stuck(goals[i], c))?;
+        scene = before.clone();
+        if merge_lanes(&mut scene, lanes.clone(), rules, &mut out).is_err() {
+            // The side-by-side run deadlocked: run the streamlines one
+            // after another, the order they were planned in (valid by
+            // construction).
+            scene = before;
+            out.steps.truncate(first_step);
+            out.streamlines_at.truncate(first_step);
+            for lane in lanes {
+                merge_lanes(&mut scene, vec![lane], rules, &mut out)
+                    .map_err(|(_, c)| PlanError::Stuck(goals[0], c))?;
+            }
+        }
         out.iterations.push(Iteration {
             sources,
             destinations: streamlines
