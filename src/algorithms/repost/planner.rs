@@ -398,7 +398,9 @@ fn merge_lanes(
                 pivot: h.pivot,
                 route: h.route,
             };
-            let occupied = |c: Cell| scene.blocked(c) && c != h.from;
+            // Cells below the ground are not modules: the ground plane is
+            // checked by the search itself.
+            let occupied = |c: Cell| scene.at.contains_key(&c) && c != h.from;
             let ok = scene.at.contains_key(&h.pivot)
                 && !scene.blocked(h.to)
                 && rules.allows(&m, &occupied)
