@@ -12,6 +12,7 @@ pub mod branch;
 pub mod comb;
 pub mod docking;
 pub mod random_walk;
+pub mod repost;
 pub mod scaffold;
 pub mod schedule_file;
 
@@ -39,6 +40,8 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &scaffold::ScaffoldAssembly,
         &docking::Docking,
         &comb::Comb2d,
+        &repost::RepostOperation,
+        &repost::Repost,
     ]
 }
 

@@ -1,0 +1,444 @@
+//! The §V planner, centralised: the paper distributes the same three steps
+//! over the meta-module leaders; computed in one place they give the same
+//! sources, destinations and streamlines.
+//!
+//! Each iteration:
+//! 1. **Sources**: SPARSE meta-modules outside the goal that are leaves of
+//!    a breadth-first spanning tree rooted at the global coordinator (a
+//!    meta-module in both shapes, the lowest), so that dismantling all of
+//!    them together leaves the rest connected.
+//! 2. **Destinations**: SPARSE goal meta-modules next to an empty goal
+//!    cell; each empty goal cell goes to exactly one destination and each
+//!    destination serves one cell.
+//! 3. **Streamlines**: maximum flow from sources to destinations with unit
+//!    capacities on the meta-modules (node splitting), by Dinic's
+//!    algorithm (`petgraph::algo::dinics`): streamlines are
+//!    vertex-disjoint, as in the authors' code, because two streamlines
+//!    crossing one meta-module would cross inside its loop.
+//! 4. **Transport**: each streamline's ten catoms travel inside the
+//!    streamline's meta-modules (their cell boxes) to the goal cell, one
+//!    catom at a time per streamline ([`super::operations::move_catoms`]),
+//!    the streamlines side by side: the k-th rotation of every streamline
+//!    runs in one time step when the motion rules say the rotations are
+//!    clear of each other and of the other streamlines' catoms, and is
+//!    delayed otherwise.
+
+use super::metamodule::{Meta, State};
+use super::operations::move_catoms;
+use super::search::{Hop, Scene};
+use crate::geometry::MotionRules;
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Cell, Motion};
+use petgraph::graph::{DiGraph, NodeIndex};
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+
+/// Why a goal cannot be planned, with the meta-module it is about.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanError {
+    /// The goal size is outside ⌈N/20⌉ ≤ S_G ≤ N/10.
+    Bound { catoms: usize, goal: usize },
+    /// No meta-module is in both shapes (no global coordinator).
+    NoCoordinator,
+    /// An empty goal cell that no streamline can reach.
+    Unreachable(Meta),
+    /// The transport search found no rotation path to a cell of `0`.
+    Stuck(Meta, Cell),
+}
+
+impl std::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlanError::Bound { catoms, goal } => write!(
+                f,
+                "goal of {goal} meta-modules is outside the bound ⌈N/20⌉ ≤ S_G ≤ N/10 for N = {catoms} catoms ({}..={})",
+                catoms.div_ceil(20),
+                catoms / 10
+            ),
+            PlanError::NoCoordinator => write!(f, "no meta-module is in both shapes"),
+            PlanError::Unreachable(m) => {
+                write!(
+                    f,
+                    "goal meta-module {m} cannot be reached by any streamline"
+                )
+            }
+            PlanError::Stuck(m, c) => write!(
+                f,
+                "no rotation path brings a catom to cell {c} of goal meta-module {m}"
+            ),
+        }
+    }
+}
+
+/// One iteration's figures.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Iteration {
+    pub sources: Vec<Meta>,
+    pub destinations: Vec<(Meta, Meta)>,
+    pub streamlines: Vec<Vec<Meta>>,
+    pub first_step: usize,
+    pub steps: usize,
+    pub motions: usize,
+}
+
+/// The plan: the initial catoms and the steps of rotations.
+#[derive(Clone, Debug, Default)]
+pub struct Plan {
+    pub modules: Vec<Cell>,
+    /// Per step: (module, pivot, hop).
+    pub steps: Vec<Vec<(ModuleId, ModuleId, Hop)>>,
+    pub iterations: Vec<Iteration>,
+    /// Streamlines in use at each step (for Fig. 9).
+    pub streamlines_at: Vec<usize>,
+    pub ground: i32,
+}
+
+/// The cells of a meta-module's box: where its catoms and the catoms
+/// flowing through it may be.
+fn region(m: Meta) -> impl Iterator<Item = Cell> {
+    let l = m.leader();
+    (-1..=2).flat_map(move |x| {
+        (-1..=1).flat_map(move |y| (0..=4).map(move |z| Cell::new(l.x + x, l.y + y, l.z + z)))
+    })
+}
+
+fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
+    super::metamodule::Direction::ALL
+        .into_iter()
+        .map(move |d| m.step(d))
+}
+
+/// Plans the reconfiguration from `initial` to `goal` (meta-module states).
+pub fn plan(
+    initial: &BTreeMap<Meta, State>,
+    goal: &BTreeSet<Meta>,
+    rules: &dyn MotionRules,
+) -> Result<Plan, PlanError> {
+    let catoms: usize = initial
+        .values()
+        .map(|s| if *s == State::Full { 20 } else { 10 })
+        .sum();
+    if goal.len() < catoms.div_ceil(20) || goal.len() > catoms / 10 {
+        return Err(PlanError::Bound {
+            catoms,
+            goal: goal.len(),
+        });
+    }
+    let gc = *initial
+        .keys()
+        .filter(|m| goal.contains(m))
+        .min_by_key(|m| (m.z, m.x, m.y))
+        .ok_or(PlanError::NoCoordinator)?;
+    let ground = 4 * initial.keys().map(|m| m.z).min().unwrap_or(0);
+    let mut scene = Scene::new(Some(ground));
+    let mut modules = Vec::new();
+    for (m, st) in initial {
+        for c in m.cells(*st) {
+            scene.insert(modules.len() as ModuleId, c);
+            modules.push(c);
+        }
+    }
+    let mut state = initial.clone();
+    let mut out = Plan {
+        modules,
+        ground,
+        ..Default::default()
+    };
+    loop {
+        let empty: Vec<Meta> = goal
+            .iter()
+            .filter(|m| !state.contains_key(m))
+            .copied()
+            .collect();
+        let extra: Vec<Meta> = state
+            .keys()
+            .filter(|m| !goal.contains(m))
+            .copied()
+            .collect();
+        if empty.is_empty() && extra.is_empty() {
+            return Ok(out);
+        }
+        // 1. Sources: leaves of the BFS tree from the coordinator.
+        let mut children: FxHashMap<Meta, usize> = FxHashMap::default();
+        let mut seen = FxHashSet::from_iter([gc]);
+        let mut queue = VecDeque::from([gc]);
+        while let Some(m) = queue.pop_front() {
+            for n in adjacent(m) {
+                if state.contains_key(&n) && seen.insert(n) {
+                    *children.entry(m).or_default() += 1;
+                    queue.push_back(n);
+                }
+            }
+        }
+        let sources: Vec<Meta> = extra
+            .iter()
+            .filter(|m| children.get(m).copied().unwrap_or(0) == 0 && state[m] == State::Sparse)
+            .copied()
+            .collect();
+        // 2. Destinations: one per empty goal cell, lowest cells first.
+        // Built bottom-up: a goal cell whose cell below is empty waits
+        // (a meta-module would otherwise hang from its destination).
+        let low = goal.iter().map(|m| m.z).min().unwrap_or(0);
+        let mut empty_sorted: Vec<Meta> = empty
+            .iter()
+            .filter(|m| {
+                m.z == low || state.contains_key(&m.step(super::metamodule::Direction::Down))
+            })
+            .copied()
+            .collect();
+        if empty_sorted.is_empty() {
+            empty_sorted = empty.clone();
+        }
+        empty_sorted.sort_by_key(|m| (m.z, m.x, m.y));
+        let mut taken: FxHashSet<Meta> = FxHashSet::default();
+        let mut destinations: Vec<(Meta, Meta)> = Vec::new();
+        for e in &empty_sorted {
+            if let Some(d) = adjacent(*e).find(|d| {
+                goal.contains(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
+            }) {
+                taken.insert(d);
+                destinations.push((d, *e));
+            }
+        }
+        // 3. Streamlines by max-flow with unit vertex capacities.
+        let streamlines = streamlines(&state, &sources, &destinations);
+        if streamlines.is_empty() {
+            let m = empty_sorted
+                .first()
+                .or(extra.first())
+                .copied()
+                .unwrap_or(gc);
+            return Err(PlanError::Unreachable(m));
+        }
+        // 4. Transport.
+        let first_step = out.steps.len();
+        let before = scene.clone();
+        let mut lanes: Vec<Vec<(Cell, Hop)>> = Vec::new();
+        let mut goals: Vec<Meta> = Vec::new();
+        for line in &streamlines {
+            let (src, dst) = (line[0], *line.last().expect("a streamline has an end"));
+            let goal_meta = destinations
+                .iter()
+                .find(|(d, _)| *d == dst)
+                .map(|(_, e)| *e)
+                .expect("a destination has its goal cell");
+            let from = src.sparse_cells();
+            let targets = goal_meta.sparse_cells();
+            // Inside the streamline's boxes first, then with one cell of
+            // margin; strictly (no sliding contact) first in each.
+            let mut found = None;
+            let mut last = targets[0];
+            'tries: for margin in [0, 1] {
+                let mut reg: FxHashSet<Cell> = FxHashSet::default();
+                for m in line.iter().chain([&goal_meta]) {
+                    for c in region(*m) {
+                        for dx in -margin..=margin {
+                            for dy in -margin..=margin {
+                                reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
+                            }
+                        }
+                    }
+                }
+                for strict in [true, false] {
+                    let mut s = scene.clone();
+                    s.region = Some(reg.clone());
+                    match move_catoms(&mut s, &from, &targets, strict) {
+                        Ok(p) => {
+                            found = Some(p);
+                            break 'tries;
+                        }
+                        Err(c) => last = c,
+                    }
+                }
+            }
+            let paths = found.ok_or(PlanError::Stuck(goal_meta, last))?;
+            // The next streamline plans against this one's end state.
+            for p in &paths {
+                let (a, b) = (p[0].from, p[p.len() - 1].to);
+                let id = scene.at.remove(&a).expect("mover in place");
+                scene.insert(id, b);
+            }
+            let mut lane = Vec::new();
+            for p in paths {
+                let start = p[0].from;
+                for h in p {
+                    lane.push((start, h));
+                }
+            }
+            lanes.push(lane);
+            goals.push(goal_meta);
+            state.remove(&src);
+            state.insert(goal_meta, State::Sparse);
+        }
+        let motions: usize = lanes.iter().map(Vec::len).sum();
+        scene = before.clone();
+        if merge_lanes(&mut scene, lanes.clone(), rules, &mut out).is_err() {
+            // The side-by-side run deadlocked: run the streamlines one
+            // after another, the order they were planned in (valid by
+            // construction).
+            scene = before;
+            out.steps.truncate(first_step);
+            out.streamlines_at.truncate(first_step);
+            for lane in lanes {
+                merge_lanes(&mut scene, vec![lane], rules, &mut out)
+                    .map_err(|(_, c)| PlanError::Stuck(goals[0], c))?;
+            }
+        }
+        out.iterations.push(Iteration {
+            sources,
+            destinations: streamlines
+                .iter()
+                .map(|l| {
+                    let d = *l.last().expect("non-empty");
+                    *destinations.iter().find(|x| x.0 == d).expect("listed")
+                })
+                .collect(),
+            steps: out.steps.len() - first_step,
+            first_step,
+            motions,
+            streamlines: streamlines.clone(),
+        });
+    }
+}
+
+/// Vertex-disjoint source → destination paths of maximum number.
+fn streamlines(
+    state: &BTreeMap<Meta, State>,
+    sources: &[Meta],
+    destinations: &[(Meta, Meta)],
+) -> Vec<Vec<Meta>> {
+    let mut g: DiGraph<(), u32> = DiGraph::new();
+    let s = g.add_node(());
+    let t = g.add_node(());
+    let mut io: BTreeMap<Meta, (NodeIndex, NodeIndex)> = BTreeMap::new();
+    for (m, st) in state {
+        // FULL meta-modules are never crossed.
+        if *st == State::Full {
+            continue;
+        }
+        let i = g.add_node(());
+        let o = g.add_node(());
+        g.add_edge(i, o, 1);
+        io.insert(*m, (i, o));
+    }
+    for (m, (_, o)) in &io {
+        for n in adjacent(*m) {
+            if let Some((i2, _)) = io.get(&n) {
+                g.add_edge(*o, *i2, 1);
+            }
+        }
+    }
+    for m in sources {
+        if let Some((i, _)) = io.get(m) {
+            g.add_edge(s, *i, 1);
+        }
+    }
+    for (d, _) in destinations {
+        if let Some((_, o)) = io.get(d) {
+            g.add_edge(*o, t, 1);
+        }
+    }
+    let (_, flows) = petgraph::algo::dinics(&g, s, t);
+    // Follow the unit flows from each source.
+    let node_meta: FxHashMap<NodeIndex, Meta> = io.iter().map(|(m, (i, _))| (*i, *m)).collect();
+    let out_of: FxHashMap<NodeIndex, Meta> = io.iter().map(|(m, (_, o))| (*o, *m)).collect();
+    let mut next: FxHashMap<NodeIndex, NodeIndex> = FxHashMap::default();
+    for e in g.edge_indices() {
+        if flows[e.index()] > 0 {
+            let (a, b) = g.edge_endpoints(e).expect("edge exists");
+            next.insert(a, b);
+        }
+    }
+    let mut lines = Vec::new();
+    for e in g.edges(s) {
+        use petgraph::visit::EdgeRef;
+        if flows[e.id().index()] == 0 {
+            continue;
+        }
+        let mut line = Vec::new();
+        let mut at = e.target();
+        while at != t {
+            if let Some(m) = node_meta.get(&at) {
+                line.push(*m);
+            }
+            let _ = out_of.get(&at);
+            at = next[&at];
+        }
+        lines.push(line);
+    }
+    lines.sort();
+    lines
+}
+
+/// Runs the lanes side by side: each step takes the next rotation of every
+/// lane whose rotation is clear of the step's other rotations and of the
+/// other lanes' catoms (rules), and whose pivot is not moving.
+fn merge_lanes(
+    scene: &mut Scene,
+    lanes: Vec<Vec<(Cell, Hop)>>,
+    rules: &dyn MotionRules,
+    out: &mut Plan,
+) -> Result<(), (usize, Cell)> {
+    let mut pos: Vec<usize> = vec![0; lanes.len()];
+    // Where each lane's current mover is, by its start cell.
+    let mut cur: Vec<Option<Cell>> = vec![None; lanes.len()];
+    loop {
+        let live: Vec<usize> = (0..lanes.len())
+            .filter(|&i| pos[i] < lanes[i].len())
+            .collect();
+        if live.is_empty() {
+            break;
+        }
+        let mut step: Vec<(usize, Hop)> = Vec::new();
+        for &i in &live {
+            let (_, h) = lanes[i][pos[i]];
+            let m = Motion::Rotate {
+                from: h.from,
+                to: h.to,
+                pivot: h.pivot,
+                route: h.route,
+            };
+            // Cells below the ground are not modules: the ground plane is
+            // checked by the search itself.
+            let occupied = |c: Cell| scene.at.contains_key(&c) && c != h.from;
+            let ok = scene.at.contains_key(&h.pivot)
+                && !scene.blocked(h.to)
+                && rules.allows(&m, &occupied)
+                && step.iter().all(|(_, o)| {
+                    let om = Motion::Rotate {
+                        from: o.from,
+                        to: o.to,
+                        pivot: o.pivot,
+                        route: o.route,
+                    };
+                    o.to != h.to
+                        && o.from != h.pivot
+                        && h.from != o.pivot
+                        && rules.concurrent_clear(&m, &om)
+                });
+            if ok {
+                step.push((i, h));
+            }
+        }
+        if step.is_empty() {
+            // Every lane waits on another lane's catom: a deadlock.
+            let i = live[0];
+            return Err((i, lanes[i][pos[i]].1.to));
+        }
+        let mut events = Vec::new();
+        for (i, h) in &step {
+            let id = scene.at.remove(&h.from).expect("the mover is in place");
+            let pivot = scene.at[&h.pivot];
+            events.push((id, pivot, *h));
+            cur[*i] = Some(h.to);
+            pos[*i] += 1;
+        }
+        for (id, _, h) in &events {
+            scene.insert(*id, h.to);
+        }
+        out.streamlines_at.push(live.len());
+        out.steps.push(events);
+    }
+    let _ = cur;
+    Ok(())
+}

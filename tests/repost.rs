@@ -1,0 +1,177 @@
+//! RePoSt (seed 001): the meta-module operations derived by search, each a
+//! sequence of real rotations that certifies clean (lattice, exact sweeps,
+//! mechanics under the default model, the structure resting on the ground).
+
+use reconfcheck::algorithms::repost::metamodule::{Direction, State};
+use reconfcheck::algorithms::repost::operation_schedule;
+use reconfcheck::algorithms::repost::operations::{self, Role};
+use reconfcheck::certify::{Options, World, certify};
+use reconfcheck::lattice::Cell;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn fill_name(fill: State) -> &'static str {
+    if fill == State::Full {
+        "full"
+    } else {
+        "sparse"
+    }
+}
+
+/// (direction, assemble, dismantle, transfer, assemble, support moves):
+/// what the search derives today. A change in the rules, the scene or the
+/// search that changes a count must be looked at (and docs/repost.md
+/// updated), not just re-pinned.
+/// Assemble FULL in the four horizontal directions is not derived (the
+/// search budget runs out): listed as missing in docs/repost.md.
+const COUNTS: &[(Direction, State, usize, usize, usize, usize)] = &[
+    (Direction::Up, State::Sparse, 15, 17, 46, 36),
+    (Direction::Down, State::Sparse, 16, 39, 44, 34),
+    (Direction::Right, State::Sparse, 33, 45, 80, 0),
+    (Direction::Left, State::Sparse, 30, 48, 80, 0),
+    (Direction::Back, State::Sparse, 31, 45, 78, 0),
+    (Direction::Front, State::Sparse, 31, 45, 79, 0),
+    (Direction::Up, State::Full, 18, 24, 56, 11),
+    (Direction::Down, State::Full, 23, 28, 49, 8),
+];
+
+#[test]
+fn every_operation_is_derived_in_all_six_directions_with_its_move_counts() {
+    let mut got = Vec::new();
+    for fill in [State::Sparse, State::Full] {
+        for dir in Direction::ALL {
+            let p = match operations::derive(dir, fill) {
+                Ok(p) => p,
+                Err(e) => {
+                    assert!(fill == State::Full && !dir.is_vertical(), "{e}");
+                    continue;
+                }
+            };
+            got.push((
+                dir,
+                fill,
+                p.count(Role::Dismantle),
+                p.count(Role::Transfer),
+                p.count(Role::Assemble),
+                p.count(Role::Support),
+            ));
+            eprintln!(
+                "{:>6} {:>6}: dismantle {:>3} transfer {:>3} assemble {:>3} support {:>3} total {:>3} strict {} {}",
+                dir.name(),
+                fill_name(fill),
+                p.count(Role::Dismantle),
+                p.count(Role::Transfer),
+                p.count(Role::Assemble),
+                p.count(Role::Support),
+                p.rotations.len(),
+                p.strict,
+                p.order
+            );
+        }
+    }
+    assert_eq!(got, COUNTS);
+}
+
+/// Each derived operation is a schedule of real rotations (pivot latched
+/// to both ends, pivot static, target free, structure connected) and ends
+/// with the source cell empty and the goal cells filled.
+#[test]
+fn every_derived_operation_replays_as_lattice_moves_and_fills_its_goal() {
+    for &(dir, fill, ..) in COUNTS {
+        let p = operations::derive(dir, fill).unwrap();
+        let s = operation_schedule(&p, 3.6);
+        let r = certify(&s, &Options::lattice_only()).unwrap();
+        assert!(r.certified, "{dir:?} {fill:?}: {}", r.summary());
+        let mut w = World::initial(&s).unwrap();
+        for (k, step) in s.steps.iter().enumerate() {
+            let plan = w.resolve(k + 1, step).unwrap();
+            w.apply(&plan);
+        }
+        let filled: Vec<Cell> = p.scene.targets();
+        for c in &filled {
+            assert!(w.config().at(*c).is_some(), "{dir:?} {fill:?}: {c} empty");
+        }
+        for c in p.scene.source.sparse_cells() {
+            assert!(
+                w.config().at(c).is_none(),
+                "{dir:?} {fill:?}: source {c} kept"
+            );
+        }
+        assert_eq!(s.move_count(), p.rotations.len());
+    }
+}
+
+/// The bundled scenario certifies clean with every check: lattice, exact
+/// sweeps and mechanics under the default model, resting on the ground.
+#[test]
+fn the_bundled_operation_scenario_certifies_clean_with_sweeps_and_mechanics() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+        .arg("run")
+        .arg(root.join("scenarios/repost-operation.toml"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        out.contains("CERTIFIED") && out.contains("mechanics"),
+        "{out}"
+    );
+    assert!(out.contains("158 moves"), "{out}");
+}
+
+/// A shape file with a cell off the meta-module lattice is unusable input:
+/// exit 2, naming the file and the cell.
+#[test]
+fn a_shape_cell_off_the_meta_module_lattice_exits_2_naming_file_and_cell() {
+    let dir = std::env::temp_dir().join(format!("repost-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("bad.txt"), "0 0 0\n4 1 0\n").unwrap();
+    std::fs::write(dir.join("good.txt"), "0 0 0\n4 0 0\n").unwrap();
+    let sc = dir.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"bad\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"good.txt\"\ngoal = \"bad.txt\"\n",
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+        .args(["generate", sc.to_str().unwrap(), "-o"])
+        .arg(dir.join("out.json"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("bad.txt") && err.contains("(4, 1, 0)"),
+        "{err}"
+    );
+}
+
+/// A goal the planner cannot reach (no meta-module in both shapes, or a
+/// goal outside the ⌈N/20⌉ ≤ S_G ≤ N/10 bound) is refused with exit 2.
+#[test]
+fn a_goal_outside_the_compression_bound_exits_2_naming_the_bound() {
+    let dir = std::env::temp_dir().join(format!("repost-bound-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("one.txt"), "0 0 0\n").unwrap();
+    std::fs::write(dir.join("three.txt"), "0 0 0\n4 0 0\n8 0 0\n").unwrap();
+    let sc = dir.join("s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"b\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"one.txt\"\ngoal = \"three.txt\"\n",
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+        .args(["generate", sc.to_str().unwrap(), "-o"])
+        .arg(dir.join("out.json"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("three.txt") && err.contains("N/10"), "{err}");
+}
