@@ -7,6 +7,7 @@ pub mod b_study;
 pub mod density;
 #[cfg(feature = "render")]
 pub mod figures;
+pub mod html;
 pub mod interop;
 pub mod parallel;
 #[cfg(feature = "render")]
