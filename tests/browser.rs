@@ -129,7 +129,10 @@ fn colliding_page() -> PathBuf {
 fn status_at(browser: &Path, page: &Path, step: usize) -> (String, String) {
     let url = format!("file://{}#step={step}", page.display());
     let (dom, console) = run_chromium(browser, &url, &["--dump-dom".to_string()]);
-    let start = dom.find("<div id=\"status\">").expect("the page has a status line") + 17;
+    let start = dom
+        .find("<div id=\"status\">")
+        .expect("the page has a status line")
+        + 17;
     let end = start + dom[start..].find("</div>").unwrap();
     (dom[start..end].to_string(), console)
 }
@@ -154,7 +157,10 @@ fn console_errors(console: &str) -> Vec<&str> {
 fn the_report_page_loads_with_no_console_errors() {
     let browser = browser_or_skip!();
     let (status, console) = status_at(&browser, &colliding_page(), 0);
-    assert!(status.starts_with("ready "), "the viewer finished: {status}\n{console}");
+    assert!(
+        status.starts_with("ready "),
+        "the viewer finished: {status}\n{console}"
+    );
     assert_eq!(field(&status, "errors"), "0", "{status}");
     assert!(console_errors(&console).is_empty(), "{console}");
 }

@@ -217,11 +217,14 @@ impl Report {
     /// full certificate.
     pub fn coverage(&self) -> (Vec<String>, Vec<String>) {
         let ran = |name: &str| self.checks.iter().any(|c| c == name);
-        let no_model = self.checks.iter().any(|c| c.starts_with("mechanics: not run"));
+        let no_model = self
+            .checks
+            .iter()
+            .any(|c| c.starts_with("mechanics: not run"));
         let lattice_only = !ran("collision") && !ran("mechanics") && !no_model;
         let covered = match self.stopped_at {
-            Some(k) => format!("steps 1..={k}"),
-            None => format!("all {} steps and the final configuration", self.steps),
+            Some(k) => format!("steps 1–{k}"),
+            None => format!("steps 1–{} and the final configuration", self.steps),
         };
         let checked = self
             .checks
@@ -383,7 +386,7 @@ mod tests {
     fn the_summary_says_what_a_lattice_only_pass_did_not_check() {
         let s = report(Vec::new(), Vec::new()).summary();
         assert!(
-            s.contains("checked: lattice (all 9 steps and the final configuration)"),
+            s.contains("checked: lattice (steps 1–9 and the final configuration)"),
             "{s}"
         );
         assert!(
@@ -405,14 +408,23 @@ mod tests {
             crate::certify::MECHANICS_NOT_RUN.into(),
         ];
         let s = r.summary();
-        assert!(s.contains("checked: lattice (all 9 steps and the final configuration); collision (all 9 steps"), "{s}");
-        assert!(s.contains("NOT checked: mechanics: no physical model"), "{s}");
+        assert!(
+            s.contains(
+                "checked: lattice (steps 1–9 and the final configuration); collision (steps 1–9"
+            ),
+            "{s}"
+        );
+        assert!(
+            s.contains("NOT checked: mechanics: no physical model"),
+            "{s}"
+        );
         assert!(!s.contains("NOT checked: collision"), "{s}");
     }
 
     #[test]
     fn a_warning_keeps_its_severity_in_the_json_and_a_violation_stays_as_before() {
-        let w = Violation::new(ViolationKind::SlidingContact, 2, "slide").severity(Severity::Warning);
+        let w =
+            Violation::new(ViolationKind::SlidingContact, 2, "slide").severity(Severity::Warning);
         let json = serde_json::to_string(&w).unwrap();
         assert!(json.contains("\"severity\":\"warning\""), "{json}");
         let back: Violation = serde_json::from_str(&json).unwrap();

@@ -20,7 +20,11 @@ pub fn check_path(path: &Path) -> Result<(), Error> {
         _ => Path::new("."),
     };
     if path.is_dir() {
-        return Err(InputError::new(format!("--html {}: is a folder, not a file", path.display())).into());
+        return Err(InputError::new(format!(
+            "--html {}: is a folder, not a file",
+            path.display()
+        ))
+        .into());
     }
     if !dir.is_dir() {
         return Err(InputError::new(format!(

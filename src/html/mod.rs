@@ -259,7 +259,8 @@ impl Page<'_> {
             .unwrap_or_default();
         let mut metrics: Vec<(String, Vec<Option<f64>>)> = Vec::new();
         if let Some(r) = self.report {
-            let mut names: Vec<&String> = r.per_step.iter().flat_map(|s| s.metrics.keys()).collect();
+            let mut names: Vec<&String> =
+                r.per_step.iter().flat_map(|s| s.metrics.keys()).collect();
             names.sort();
             names.dedup();
             for name in names {

@@ -39,9 +39,10 @@ fn inlined(html: &str) -> serde_json::Value {
 fn the_inlined_replay_gives_the_schedules_configuration_at_every_step() {
     let s = scaffold();
     assert!(
-        s.steps
+        s.steps.iter().any(|st| st
+            .events
             .iter()
-            .any(|st| st.events.iter().any(|e| matches!(e, crate::schedule::Event::Enter { .. }))),
+            .any(|e| matches!(e, crate::schedule::Event::Enter { .. }))),
         "the case has modules entering"
     );
     let html = Page {
@@ -57,7 +58,12 @@ fn the_inlined_replay_gives_the_schedules_configuration_at_every_step() {
     assert_eq!(replay.cells_after(0), config(&world));
     for k in 0..s.steps.len() {
         certify::advance(&mut world, &s, k, |_| ()).unwrap();
-        assert_eq!(replay.cells_after(k + 1), config(&world), "after step {}", k + 1);
+        assert_eq!(
+            replay.cells_after(k + 1),
+            config(&world),
+            "after step {}",
+            k + 1
+        );
     }
 }
 
@@ -117,8 +123,18 @@ fn the_page_loads_nothing_from_the_network() {
     }
     .html();
     let lower = html.to_lowercase();
-    for loader in ["src=\"http", "href=\"http", "<link", "<img", "<iframe", "url(http"] {
-        assert!(!lower.contains(loader), "the page loads something: {loader}");
+    for loader in [
+        "src=\"http",
+        "href=\"http",
+        "<link",
+        "<img",
+        "<iframe",
+        "url(http",
+    ] {
+        assert!(
+            !lower.contains(loader),
+            "the page loads something: {loader}"
+        );
     }
     // And the browser is told to refuse any load.
     assert!(html.contains("default-src 'none'"));
@@ -146,9 +162,10 @@ fn text_that_would_end_a_script_element_stays_inside_the_data() {
 #[test]
 fn a_load_map_colours_every_connector_by_its_utilisation() {
     let s = colliding_walk();
-    let model =
-        crate::mechanics::Model::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"))
-            .unwrap();
+    let model = crate::mechanics::Model::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"),
+    )
+    .unwrap();
     let maps = certify::load_maps_at(&s, &model, &[2, s.steps.len() + 1]).unwrap();
     assert_eq!(maps.iter().map(|m| m.0).collect::<Vec<_>>(), [2, 4]);
     let (step, st, a) = &maps[0];
