@@ -54,7 +54,11 @@ pub fn write_report(
         let model = reconfcheck::mechanics::Model::load(&model_path)?;
         let steps = html::load_map_steps(report, LOAD_MAPS);
         for (k, st, a) in certify::load_maps_at(s, &model, &steps).map_err(|e| e.in_file(origin))? {
-            load_maps.push(html::load_map(k, &st, &a));
+            // A step whose structure has no connector (all fixed, say)
+            // has nothing to colour.
+            if !st.links.is_empty() {
+                load_maps.push(html::load_map(k, &st, &a));
+            }
         }
     }
     let page = Page {

@@ -265,6 +265,11 @@ mod tests {
             // On the surface: the support function in direction n is p·n.
             assert!((body.support(n) - p.dot(n)).abs() < 1e-6);
         }
+        // Wound counter-clockwise seen from outside (what WebGL culls by).
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| glam::Vec3::from_array(m.normals[i as usize]));
+            assert!((b - a).cross(c - a).dot(a + b + c) > 0.0);
+        }
         // Closed: every edge is shared by exactly two triangles.
         let mut edges = std::collections::HashMap::new();
         for t in &m.triangles {

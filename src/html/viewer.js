@@ -142,8 +142,8 @@
     scene.background = new THREE.Color(0xf4f6f8);
     const camera = new THREE.PerspectiveCamera(40, width / height, 0.05, 5000);
     camera.up.set(0, 0, 1);
-    scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 2.2));
-    const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+    scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.0));
+    const sun = new THREE.DirectionalLight(0xffffff, 0.9);
     scene.add(sun);
 
     let geo;
@@ -172,7 +172,7 @@
     if (!isFinite(lo[0])) { lo.fill(-1); hi.fill(1); }
     const mid = lo.map((v, a) => (v + hi[a]) / 2), span = Math.max(2, ...hi.map((v, a) => v - lo[a]));
     if (R.ground !== null && R.ground !== undefined) {
-      const g = new THREE.Mesh(new THREE.PlaneGeometry(span * 1.6, span * 1.6), new THREE.MeshLambertMaterial({ color: 0xd8d2c4 }));
+      const g = new THREE.Mesh(new THREE.PlaneGeometry(span * 1.6, span * 1.6), new THREE.MeshBasicMaterial({ color: 0xe4dfd3 }));
       g.position.set(mid[0], mid[1], R.ground);
       scene.add(g);
     }
@@ -290,9 +290,10 @@
       if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
       slider.value = k;
       label.textContent = k === 0 ? `initial (0 / ${steps})` : k === last ? `final (${steps} / ${steps})` : `step ${k} / ${steps}`;
-      info.replaceChildren(el('h3', {}, label.textContent),
+      info.replaceChildren(...[el('h3', {}, label.textContent),
         showLoad ? el('p', {}, `load map: max utilisation ${fmt(lm.max_utilisation)} over ${lm.links.length} connectors`) : null,
-        found.length ? el('ul', {}, ...found.slice(0, 50).map(v => el('li', { class: v.severity }, `${v.severity} ${v.kind}: ${v.message}`))) : el('p', {}, 'no findings at this step'));
+        found.length ? el('ul', {}, ...found.slice(0, 50).map(v => el('li', { class: v.severity }, `${v.severity} ${v.kind}: ${v.message}`))) : el('p', {}, 'no findings at this step'),
+        found.length > 50 ? el('p', {}, `… ${found.length - 50} more`) : null].filter(x => x));
       state.step = k; state.highlighted = highlighted; state.markers = markers.children.length; state.loadmap = showLoad ? lm.links.length : 0;
       draw();
       report();
