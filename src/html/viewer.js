@@ -202,8 +202,11 @@
     // Markers of the findings and the load map, rebuilt per step.
     const markers = new THREE.Group();
     scene.add(markers);
-    const markMat = new THREE.MeshBasicMaterial({ color: 0xff00ff, depthTest: false });
-    const cellMat = new THREE.LineBasicMaterial({ color: 0xff00ff, depthTest: false });
+    // Transparent (at full opacity) so that they are drawn in the same pass
+    // as the bodies, after them (renderOrder), and without a depth test:
+    // always in view.
+    const markMat = new THREE.MeshBasicMaterial({ color: 0xff00ff, depthTest: false, transparent: true });
+    const cellMat = new THREE.LineBasicMaterial({ color: 0xff00ff, depthTest: false, transparent: true });
     const cellGeo = new THREE.EdgesGeometry(new THREE.BoxGeometry(0.8, 0.8, 0.8));
     const witnessGeo = new THREE.SphereGeometry(0.09, 16, 12);
     const byStep = new Map();
@@ -268,7 +271,7 @@
         for (const id of v.modules) { const m = index.get(id); if (m !== undefined && bad) tint(m, COL.bad); }
         for (const c of v.cells) { const l = new THREE.LineSegments(cellGeo, cellMat); l.position.set(...c); l.renderOrder = 2; markers.add(l); }
         for (const w of v.witness) { const b = new THREE.Mesh(witnessGeo, markMat); b.position.set(...w); b.renderOrder = 3; markers.add(b); }
-        if (v.witness.length === 2) markers.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(v.witness.map(w => new THREE.Vector3(...w))), cellMat));
+        if (v.witness.length === 2) { const l = new THREE.Line(new THREE.BufferGeometry().setFromPoints(v.witness.map(w => new THREE.Vector3(...w))), cellMat); l.renderOrder = 3; markers.add(l); }
       }
       // Load map: connectors as small plates coloured by utilisation.
       const lm = loadSteps.get(k);
