@@ -314,7 +314,7 @@ impl Page<'_> {
             escape(&self.title)
         ));
         out.push_str("<script type=\"application/json\" id=\"reconfcheck-data\">");
-        out.push_str(&script_safe(&data));
+        out.push_str(&json_in_script(&data));
         out.push_str("</script>\n<script>\n/* three.js r160 — ");
         out.push_str(&THREE_LICENSE.replace("*/", "* /"));
         out.push_str(" */\n");
@@ -336,6 +336,13 @@ fn escape(s: &str) -> String {
 /// Text that cannot end the `<script>` element it is inlined in.
 fn script_safe(s: &str) -> String {
     s.replace("</", "<\\/")
+}
+
+/// JSON that cannot end or alter the `<script>` element it is inlined in:
+/// every `<` (only ever inside a string) written as `\u003c`, which any
+/// JSON parser reads back as `<`.
+fn json_in_script(s: &str) -> String {
+    s.replace('<', "\\u003c")
 }
 
 #[cfg(test)]

@@ -153,6 +153,12 @@ fn text_that_would_end_a_script_element_stays_inside_the_data() {
         ..Default::default()
     }
     .html();
+    // Four script elements, each closed once, and nothing opened in the data.
+    assert_eq!(
+        html.matches("</script>").count(),
+        4,
+        "no script was ended early"
+    );
     assert_eq!(html.matches("<script").count(), 4, "no script was injected");
     let data = inlined(&html);
     assert_eq!(data["summary"]["schedule"], report.schedule.as_str());
