@@ -124,7 +124,7 @@ impl Replay {
     /// configuration), decoded the way the page decodes them: what the
     /// tests compare with the schedule's own replay.
     pub fn cells_after(&self, step: usize) -> HashMap<ModuleId, Cell> {
-        let ints = |s: &str| unbase64(s);
+        let ints = unbase64;
         let (initial, moves, jumps, enters, leaves) = (
             ints(&self.initial),
             ints(&self.moves),
