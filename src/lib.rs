@@ -21,7 +21,9 @@
 //! 7. [`study`] — questions asked over many schedules (the b-study, the
 //!    density study, load maps, synthetic benchmarks);
 //! 8. [`render`] (feature `render`, on by default) — pictures and plots of
-//!    all of the above.
+//!    all of the above;
+//! 8. [`html`] — one self-contained HTML page of a report or a study: a 3D
+//!    replay (three.js inlined), tables and curves.
 //!
 //! [`error`], [`number`] and [`progress`] are leaves every layer may use:
 //! errors, validated numbers, progress reports. The library never prints,
@@ -33,6 +35,7 @@ pub mod algorithms;
 pub mod certify;
 pub mod error;
 pub mod geometry;
+pub mod html;
 pub mod interop;
 pub mod lattice;
 pub mod mechanics;

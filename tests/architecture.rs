@@ -21,6 +21,7 @@ const RANKS: &[(&str, u32)] = &[
     ("interop", 6),
     ("study", 7),
     ("render", 8),
+    ("html", 8),
 ];
 
 /// Arrows the ranks alone would allow but the design forbids: generators

@@ -1,7 +1,7 @@
 //! True collision check (SPEC §4.3): each step's sweeps, through the
 //! lattice's [`SweepModel`].
 
-use super::report::{Violation, ViolationKind};
+use super::report::{Severity, Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
 use crate::geometry::{Contact, ContactKind, Obstacle, SweepInput, SweepModel};
 use crate::lattice::Motion;
@@ -38,7 +38,7 @@ impl StepCheck for CollisionCheck {
             let v = contact_violation(&c, ctx);
             match c.kind {
                 ContactKind::Collision => out.violations.push(v),
-                ContactKind::SlidingContact => out.warnings.push(v),
+                ContactKind::SlidingContact => out.warnings.push(v.severity(Severity::Warning)),
             }
         }
         if deepest > 0.0 {

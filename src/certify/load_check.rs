@@ -279,6 +279,41 @@ pub fn replay(
     Ok(())
 }
 
+/// The structure and its analysis at each of `steps` (1-based; `steps + 1`
+/// of the schedule is the final configuration), in one replay that solves
+/// only those steps: what a viewer needs to show a few load maps of a long
+/// schedule without the cost of analysing every step.
+pub fn load_maps_at(
+    schedule: &crate::schedule::Schedule,
+    model: &Model,
+    steps: &[usize],
+) -> Result<Vec<(usize, Structure, Analysis)>, crate::error::InputError> {
+    let check = LoadCheck::new(model, schedule.spacing.metres(), false)?;
+    let mut world = World::initial(schedule)?;
+    let mut found = Vec::new();
+    let last = steps.iter().copied().max().unwrap_or(0);
+    for k in 0..schedule.steps.len().min(last) {
+        let wanted = steps.contains(&(k + 1));
+        let (seen, _, clashes) = super::advance(&mut world, schedule, k, |ctx| {
+            wanted.then(|| {
+                let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
+                check.analyse(ctx.world, &ctx.plan.moving, &movers)
+            })
+        })?;
+        if let Some((s, a)) = seen {
+            found.push((k + 1, s, a));
+        }
+        if !clashes.is_empty() {
+            return Ok(found);
+        }
+    }
+    if steps.contains(&(schedule.steps.len() + 1)) {
+        let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
+        found.push((schedule.steps.len() + 1, s, a));
+    }
+    Ok(found)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

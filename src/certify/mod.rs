@@ -19,8 +19,8 @@ pub use collision_check::CollisionCheck;
 pub use docking_check::DockingCheck;
 pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
-pub use load_check::{LoadCheck, replay};
-pub use report::{Report, StepResult, Violation, ViolationKind};
+pub use load_check::{LoadCheck, load_maps_at, replay};
+pub use report::{Report, Severity, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;

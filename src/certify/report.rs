@@ -74,10 +74,43 @@ impl ViolationKind {
     }
 }
 
+/// How much a finding matters: a violation refuses the certificate, a
+/// warning deserves a look, a note is information. Kept on each finding so
+/// that readers (the summary, the HTML page, CI) rank them alike.
+#[derive(
+    Copy, Clone, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Severity {
+    Note,
+    Warning,
+    #[default]
+    Error,
+}
+
+impl Severity {
+    pub fn name(self) -> &'static str {
+        match self {
+            Severity::Note => "note",
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        }
+    }
+
+    /// Errors are the default and left out of the JSON, which keeps the
+    /// violations' JSON as it was before severities existed.
+    fn is_error(&self) -> bool {
+        *self == Severity::Error
+    }
+}
+
 /// One finding of a check.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Violation {
     pub kind: ViolationKind,
+    /// `error` for violations (left out of the JSON), lower for warnings.
+    #[serde(default, skip_serializing_if = "Severity::is_error")]
+    pub severity: Severity,
     /// Time step (1-based); `steps + 1` is the final configuration.
     pub step: usize,
     pub modules: Vec<ModuleId>,
@@ -92,12 +125,18 @@ impl Violation {
     pub fn new(kind: ViolationKind, step: usize, message: impl Into<String>) -> Self {
         Violation {
             kind,
+            severity: Severity::Error,
             step,
             modules: Vec::new(),
             cells: Vec::new(),
             message: message.into(),
             detail: BTreeMap::new(),
         }
+    }
+
+    pub fn severity(mut self, s: Severity) -> Self {
+        self.severity = s;
+        self
     }
 
     pub fn modules(mut self, m: impl IntoIterator<Item = ModuleId>) -> Self {
@@ -174,6 +213,67 @@ impl Report {
         m
     }
 
+    /// Counts of warnings by kind and severity.
+    pub fn warning_counts(&self) -> BTreeMap<(ViolationKind, Severity), usize> {
+        let mut m = BTreeMap::new();
+        for w in &self.warnings {
+            *m.entry((w.kind, w.severity)).or_insert(0) += 1;
+        }
+        m
+    }
+
+    /// What this report vouches for and what it does not: the checks that
+    /// ran (with the steps they covered), and each check that did not run
+    /// with the reason, so that a lattice-only pass is never read as a
+    /// full certificate.
+    pub fn coverage(&self) -> (Vec<String>, Vec<String>) {
+        let ran = |name: &str| self.checks.iter().any(|c| c == name);
+        let no_model = self
+            .checks
+            .iter()
+            .any(|c| c.starts_with("mechanics: not run"));
+        let lattice_only = !ran("collision") && !ran("mechanics") && !no_model;
+        let covered = match self.stopped_at {
+            Some(k) => format!("steps 1–{k}"),
+            None => format!("steps 1–{} and the final configuration", self.steps),
+        };
+        let checked = self
+            .checks
+            .iter()
+            .filter(|c| !c.contains(": not run"))
+            .map(|c| format!("{c} ({covered})"))
+            .collect();
+        let mut not_checked = Vec::new();
+        if !ran("collision") {
+            not_checked.push(if crate::geometry::sweep_model(self.lattice).is_none() {
+                format!(
+                    "collision: no body model for the {} lattice",
+                    self.lattice.name()
+                )
+            } else if lattice_only {
+                "collision: lattice checks only (--lattice-only)".to_string()
+            } else {
+                "collision: not requested".to_string()
+            });
+        }
+        if !ran("mechanics") {
+            not_checked.push(if no_model {
+                "mechanics: no physical model (pass --model FILE or name one in the schedule)"
+                    .to_string()
+            } else if lattice_only {
+                "mechanics: lattice checks only (--lattice-only)".to_string()
+            } else {
+                "mechanics: not requested".to_string()
+            });
+        }
+        if let Some(k) = self.stopped_at {
+            not_checked.push(format!(
+                "steps after {k}: the state is undefined from there on"
+            ));
+        }
+        (checked, not_checked)
+    }
+
     /// A readable summary: verdict, counts, the first findings.
     pub fn summary(&self) -> String {
         let mut s = String::new();
@@ -193,6 +293,11 @@ impl Report {
             self.moves
         );
         let _ = writeln!(s, "checks: {}", self.checks.join(", "));
+        let (checked, not_checked) = self.coverage();
+        let _ = writeln!(s, "checked: {}", checked.join("; "));
+        for n in &not_checked {
+            let _ = writeln!(s, "NOT checked: {n}");
+        }
         for (k, n) in self.violation_counts() {
             let _ = writeln!(s, "  {n:>6} × {}", k.name());
         }
@@ -214,15 +319,18 @@ impl Report {
         }
         if !self.warnings.is_empty() {
             let _ = writeln!(s, "warnings: {}", self.warnings.len());
-            let mut by_kind: BTreeMap<ViolationKind, usize> = BTreeMap::new();
-            for w in &self.warnings {
-                *by_kind.entry(w.kind).or_insert(0) += 1;
-            }
-            for (k, n) in by_kind {
-                let _ = writeln!(s, "  {n:>6} × {}", k.name());
+            for ((k, sev), n) in self.warning_counts() {
+                let _ = writeln!(s, "  {n:>6} × {} ({})", k.name(), sev.name());
             }
             for w in self.warnings.iter().take(5) {
-                let _ = writeln!(s, "  step {}: {}: {}", w.step, w.kind.name(), w.message);
+                let _ = writeln!(
+                    s,
+                    "  step {}: {} {}: {}",
+                    w.step,
+                    w.severity.name(),
+                    w.kind.name(),
+                    w.message
+                );
             }
             if self.warnings.len() > 5 {
                 let _ = writeln!(
@@ -286,6 +394,60 @@ mod tests {
     }
 
     #[test]
+    fn the_summary_says_what_a_lattice_only_pass_did_not_check() {
+        let s = report(Vec::new(), Vec::new()).summary();
+        assert!(
+            s.contains("checked: lattice (steps 1–9 and the final configuration)"),
+            "{s}"
+        );
+        assert!(
+            s.contains("NOT checked: collision: lattice checks only (--lattice-only)"),
+            "{s}"
+        );
+        assert!(
+            s.contains("NOT checked: mechanics: lattice checks only (--lattice-only)"),
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn the_summary_says_mechanics_was_not_checked_without_a_model() {
+        let mut r = report(Vec::new(), Vec::new());
+        r.checks = vec![
+            "lattice".into(),
+            "collision".into(),
+            crate::certify::MECHANICS_NOT_RUN.into(),
+        ];
+        let s = r.summary();
+        assert!(
+            s.contains(
+                "checked: lattice (steps 1–9 and the final configuration); collision (steps 1–9"
+            ),
+            "{s}"
+        );
+        assert!(
+            s.contains("NOT checked: mechanics: no physical model"),
+            "{s}"
+        );
+        assert!(!s.contains("NOT checked: collision"), "{s}");
+    }
+
+    #[test]
+    fn a_warning_keeps_its_severity_in_the_json_and_a_violation_stays_as_before() {
+        let w =
+            Violation::new(ViolationKind::SlidingContact, 2, "slide").severity(Severity::Warning);
+        let json = serde_json::to_string(&w).unwrap();
+        assert!(json.contains("\"severity\":\"warning\""), "{json}");
+        let back: Violation = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.severity, Severity::Warning);
+        let v = Violation::new(ViolationKind::Collision, 2, "bump");
+        let json = serde_json::to_string(&v).unwrap();
+        assert!(!json.contains("severity"), "{json}");
+        let back: Violation = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.severity, Severity::Error);
+    }
+
+    #[test]
     fn the_summary_names_the_module_count_at_the_start_and_at_the_end() {
         let s = report(Vec::new(), Vec::new()).summary();
         assert!(s.contains("3 modules at the start, 5 at the end"), "{s}");
@@ -293,17 +455,23 @@ mod tests {
 
     #[test]
     fn the_summary_counts_findings_by_kind_and_lists_the_first() {
-        let slide = |k| Violation::new(ViolationKind::SlidingContact, k, format!("slide {k}"));
+        let slide = |k| {
+            Violation::new(ViolationKind::SlidingContact, k, format!("slide {k}"))
+                .severity(Severity::Warning)
+        };
         let warnings: Vec<Violation> = (1..=7).map(slide).collect();
         let collision = Violation::new(ViolationKind::Collision, 4, "bump");
         let text = report(vec![collision], warnings).summary();
         assert!(text.starts_with("NOT CERTIFIED: s.json"), "{text}");
         assert!(text.contains("       1 × collision"), "{text}");
         assert!(
-            text.contains("warnings: 7\n       7 × sliding_contact"),
+            text.contains("warnings: 7\n       7 × sliding_contact (warning)"),
             "{text}"
         );
-        assert!(text.contains("step 5: sliding_contact: slide 5"), "{text}");
+        assert!(
+            text.contains("step 5: warning sliding_contact: slide 5"),
+            "{text}"
+        );
         assert!(!text.contains("slide 6"), "{text}");
         assert!(
             text.contains("… 2 more warnings in the JSON report"),

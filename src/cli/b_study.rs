@@ -45,6 +45,9 @@ pub struct Args {
     /// Never show a progress bar.
     #[arg(long)]
     no_progress: bool,
+    /// Write the study as a self-contained HTML page (curves and table).
+    #[arg(long, value_name = "REPORT.html")]
+    html: Option<PathBuf>,
 }
 
 /// `--pressure` in kPa as the model's pressure in Pa: positive and finite
@@ -64,6 +67,9 @@ pub fn run(a: Args) -> Result<u8, Error> {
             None => m.connector.pressure,
         };
         m = m.with_connector(pressure, a.bending.unwrap_or(m.connector.bending));
+    }
+    if let Some(p) = &a.html {
+        super::html::check_path(p)?;
     }
     let (lo, hi) = b_study::default_range(&a.family);
     let (b_min, b_max) = (a.b_min.unwrap_or(lo), a.b_max.unwrap_or(hi));
@@ -105,6 +111,9 @@ pub fn run(a: Args) -> Result<u8, Error> {
     if let Some(p) = &a.plot {
         reconfcheck::render::b_study_plot(&st, p)?;
         eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.html {
+        super::html::write_study(p, &st)?;
     }
     if let Some(p) = &a.json {
         write_file(

@@ -9,6 +9,7 @@ pub mod density;
 pub mod docking;
 #[cfg(feature = "render")]
 pub mod figures;
+pub mod html;
 pub mod interop;
 pub mod parallel;
 #[cfg(feature = "render")]

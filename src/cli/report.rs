@@ -48,6 +48,10 @@ pub struct ReportArgs {
     /// comparison still accepts.
     #[arg(long, default_value_t = 1e-3, requires = "baseline")]
     baseline_tolerance: f64,
+    /// Also write a self-contained HTML page: summary, tables, curves and
+    /// a 3D replay of the schedule with its findings (no network needed).
+    #[arg(long, value_name = "REPORT.html")]
+    html: Option<std::path::PathBuf>,
 }
 
 impl ReportArgs {
@@ -76,6 +80,9 @@ impl ReportArgs {
 /// the report; the exit code says whether it was certified.
 pub fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<u8, Error> {
     let opts = args.options(origin)?;
+    if let Some(p) = &args.html {
+        super::html::check_path(p)?;
+    }
     let tolerance = reconfcheck::number::within(args.baseline_tolerance, 0.0, f64::MAX, "≥ 0")
         .map_err(|e| InputError::new(format!("--baseline-tolerance: {e}")))?;
     let report = certify::certify_by(s, &opts, super::parallel::runner().as_ref())
@@ -100,6 +107,9 @@ pub fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Res
     }
     if let Some(p) = &args.junit {
         write_file(p, certify::to_junit(&report))?;
+    }
+    if let Some(p) = &args.html {
+        super::html::write_report(p, s, origin, &report, &opts)?;
     }
     if args.print_json {
         println!("{json}");

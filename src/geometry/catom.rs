@@ -150,6 +150,102 @@ impl Catom {
     }
 }
 
+/// A triangle mesh of a body's surface, for viewers (f32: what WebGL reads).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceMesh {
+    pub positions: Vec<[f32; 3]>,
+    /// Outward unit normal at each position.
+    pub normals: Vec<[f32; 3]>,
+    /// Counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Catom {
+    /// The surface of the rounded body (units of d, at rest), sampled from
+    /// its exact support map: each direction `u` of a geodesic sphere
+    /// (an icosahedron split `subdivisions` times) maps to the surface
+    /// point whose outward normal is `u`. Every point lies on the real
+    /// body, the normals are exact, and the sphere's triangles stay a
+    /// closed surface; flat faces appear where neighbouring directions
+    /// pick different vertices of `Q`.
+    pub fn surface_mesh(&self, subdivisions: u32) -> SurfaceMesh {
+        let (dirs, triangles) = geodesic_sphere(subdivisions);
+        let positions = dirs
+            .iter()
+            .map(|u| self.support_point(*u).as_vec3().to_array())
+            .collect();
+        let normals = dirs.iter().map(|u| u.as_vec3().to_array()).collect();
+        SurfaceMesh {
+            positions,
+            normals,
+            triangles,
+        }
+    }
+}
+
+/// Unit directions of an icosahedron split `n` times (each triangle into
+/// four), with its triangles.
+fn geodesic_sphere(n: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<DVec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
+    .collect();
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..n {
+        let mut mid = std::collections::HashMap::new();
+        let mut split = |a: u32, b: u32, v: &mut Vec<DVec3>| -> u32 {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push(((v[a as usize] + v[b as usize]) / 2.0).normalize());
+                (v.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(f.len() * 4);
+        for [a, b, c] in f {
+            let ab = split(a, b, &mut v);
+            let bc = split(b, c, &mut v);
+            let ca = split(c, a, &mut v);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    (v, f)
+}
+
 /// A rigid pose from a centre and a rotation.
 #[cfg(test)]
 pub fn pose(centre: DVec3, rotation: DQuat) -> Pose {
@@ -158,6 +254,33 @@ pub fn pose(centre: DVec3, rotation: DQuat) -> Pose {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_surface_mesh_lies_on_the_body_and_is_closed() {
+        let body = super::catom();
+        let m = body.surface_mesh(2);
+        assert_eq!(m.triangles.len(), 320);
+        for (p, n) in m.positions.iter().zip(&m.normals) {
+            let p = glam::Vec3::from_array(*p).as_dvec3();
+            let n = glam::Vec3::from_array(*n).as_dvec3();
+            // On the surface: the support function in direction n is p·n.
+            assert!((body.support(n) - p.dot(n)).abs() < 1e-6);
+        }
+        // Wound counter-clockwise seen from outside (what WebGL culls by).
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| glam::Vec3::from_array(m.normals[i as usize]));
+            assert!((b - a).cross(c - a).dot(a + b + c) > 0.0);
+        }
+        // Closed: every edge is shared by exactly two triangles.
+        let mut edges = std::collections::HashMap::new();
+        for t in &m.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        assert!(edges.values().all(|&k| k == 2));
+    }
+
     use super::*;
     use crate::lattice::fcc;
 

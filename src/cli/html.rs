@@ -1,0 +1,86 @@
+//! `--html REPORT.html`: the self-contained report page of `certify`, `run`
+//! and `b-study` (see `docs/report.md`).
+
+use reconfcheck::certify::{self, Options, Report};
+use reconfcheck::error::{Error, InputError, write_file};
+use reconfcheck::html::{self, Page};
+use reconfcheck::schedule::Schedule;
+use reconfcheck::study::b_study::Study;
+use std::path::Path;
+
+/// Load maps a page carries at most: each is one more structure analysed.
+const LOAD_MAPS: usize = 4;
+
+/// Refuses an `--html` path whose folder does not exist before any work is
+/// done: a certification of the sandcastle takes minutes, and its page
+/// should not be lost to a typo (exit 2, the flag's error).
+pub fn check_path(path: &Path) -> Result<(), Error> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if path.is_dir() {
+        return Err(InputError::new(format!(
+            "--html {}: is a folder, not a file",
+            path.display()
+        ))
+        .into());
+    }
+    if !dir.is_dir() {
+        return Err(InputError::new(format!(
+            "--html {}: cannot write the report there: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Writes the page of a certification of `s` (read from `origin`): the
+/// replay, the report, and load maps of its worst steps where the
+/// mechanics ran.
+pub fn write_report(
+    path: &Path,
+    s: &Schedule,
+    origin: &Path,
+    report: &Report,
+    opts: &Options,
+) -> Result<(), Error> {
+    let mut load_maps = Vec::new();
+    if report.checks.iter().any(|c| c == "mechanics")
+        && let Some(model_path) = certify::model_path(s, opts)
+    {
+        let model = reconfcheck::mechanics::Model::load(&model_path)?;
+        let steps = html::load_map_steps(report, LOAD_MAPS);
+        for (k, st, a) in certify::load_maps_at(s, &model, &steps).map_err(|e| e.in_file(origin))? {
+            // A step whose structure has no connector (all fixed, say)
+            // has nothing to colour.
+            if !st.links.is_empty() {
+                load_maps.push(html::load_map(k, &st, &a));
+            }
+        }
+    }
+    let page = Page {
+        title: format!("reconfcheck: {}", origin.display()),
+        report: Some(report),
+        schedule: Some(s),
+        load_maps,
+        study: None,
+    };
+    write_file(path, page.html())?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Writes the page of a b-study: its curves and table.
+pub fn write_study(path: &Path, st: &Study) -> Result<(), Error> {
+    let page = Page {
+        title: format!("reconfcheck b-study: {}", st.family),
+        study: Some(st),
+        ..Default::default()
+    };
+    write_file(path, page.html())?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}

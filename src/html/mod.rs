@@ -1,0 +1,349 @@
+//! One self-contained HTML page of a certification or a study: summary,
+//! tables and curves, and a 3D replay of the schedule (three.js, inlined
+//! from `assets/three/`, so that the page needs no network).
+//!
+//! The page is data plus a fixed viewer: everything the viewer shows is in
+//! one JSON object inlined in the page ([`PageData`]), the schedule as
+//! per-step deltas ([`replay::Replay`]). The viewer script is
+//! `src/html/viewer.js`; it reads a URL hash `#step=K` (the step shown
+//! first) and writes its state into `document.title` and the element
+//! `#status` once drawn, which the browser test reads.
+
+pub mod replay;
+
+use crate::certify::{Report, Severity, Violation};
+use crate::lattice::{Cell, LatticeKind};
+use crate::mechanics::analysis::Analysis;
+use crate::mechanics::structure::Structure;
+use crate::schedule::Schedule;
+use crate::study::b_study::Study;
+use serde::Serialize;
+
+/// three.js r160 (MIT), the pinned minified build from the npm registry.
+const THREE_JS: &str = include_str!("../../assets/three/three.min.js");
+const THREE_LICENSE: &str = include_str!("../../assets/three/LICENSE");
+const VIEWER_JS: &str = include_str!("viewer.js");
+const STYLE_CSS: &str = include_str!("style.css");
+
+/// Findings listed one by one in the page; the rest are counted (a
+/// sandcastle can warn hundreds of thousands of times).
+const MAX_LISTED: usize = 5000;
+
+/// Modules above which the body mesh is drawn coarser, so that a scene of
+/// tens of thousands of catoms stays interactive on a software renderer.
+const DETAILED_BELOW: usize = 4000;
+
+/// What a page shows; every part is optional.
+#[derive(Default)]
+pub struct Page<'a> {
+    pub title: String,
+    pub report: Option<&'a Report>,
+    pub schedule: Option<&'a Schedule>,
+    /// Load maps of chosen steps (see [`load_map`]).
+    pub load_maps: Vec<LoadMap>,
+    pub study: Option<&'a Study>,
+}
+
+/// The connectors of one step with their utilisation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LoadMap {
+    pub step: usize,
+    pub max_utilisation: f64,
+    /// `[x, y, z, nx, ny, nz, utilisation]` per connector: its contact
+    /// point and normal (units of d).
+    pub links: Vec<[f32; 7]>,
+}
+
+/// The load map of a structure and its analysis at `step`.
+pub fn load_map(step: usize, s: &Structure, a: &Analysis) -> LoadMap {
+    let links = s
+        .links
+        .iter()
+        .zip(&a.links)
+        .map(|(l, r)| {
+            let (c, n) = (l.contact.as_vec3(), l.normal.as_vec3());
+            [c.x, c.y, c.z, n.x, n.y, n.z, r.utilisation as f32]
+        })
+        .collect();
+    LoadMap {
+        step,
+        max_utilisation: a.max_utilisation,
+        links,
+    }
+}
+
+/// The steps worth a load map in `report`: the step of the highest
+/// utilisation and the first overloaded steps (at most `n` in all).
+pub fn load_map_steps(report: &Report, n: usize) -> Vec<usize> {
+    let mut steps = Vec::new();
+    let worst = report
+        .per_step
+        .iter()
+        .filter_map(|r| r.metrics.get("max_utilisation").map(|u| (*u, r.step)))
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    steps.extend(worst.map(|w| w.1));
+    for v in &report.violations {
+        if steps.len() >= n {
+            break;
+        }
+        if v.kind == crate::certify::ViolationKind::Overload && !steps.contains(&v.step) {
+            steps.push(v.step);
+        }
+    }
+    steps.sort_unstable();
+    steps
+}
+
+/// Everything the viewer reads, inlined as JSON.
+#[derive(Serialize)]
+pub struct PageData<'a> {
+    pub title: &'a str,
+    pub generator: String,
+    pub summary: Option<Summary>,
+    pub violations: Vec<Finding>,
+    pub warnings: Vec<Finding>,
+    pub warnings_total: usize,
+    pub warning_counts: Vec<(String, Severity, usize)>,
+    pub violation_counts: Vec<(String, usize)>,
+    /// Per metric: its value at each step (`null` where not measured).
+    pub metrics: Vec<(String, Vec<Option<f64>>)>,
+    pub replay: Option<Scene>,
+    pub load_maps: &'a [LoadMap],
+    pub study: Option<&'a Study>,
+}
+
+/// The report's header and verdict.
+#[derive(Serialize)]
+pub struct Summary {
+    pub certified: bool,
+    pub schedule: String,
+    pub lattice: String,
+    pub modules: usize,
+    pub final_modules: usize,
+    pub steps: usize,
+    pub moves: usize,
+    pub checked: Vec<String>,
+    pub not_checked: Vec<String>,
+    pub stopped_at: Option<usize>,
+}
+
+/// One violation or warning, placed in the scene.
+#[derive(Serialize)]
+pub struct Finding {
+    pub step: usize,
+    pub kind: String,
+    pub severity: Severity,
+    pub message: String,
+    pub modules: Vec<u32>,
+    /// Centres of the cells it names (units of d).
+    pub cells: Vec<[f64; 3]>,
+    /// Witness points (collision checks: on the mover and on the other).
+    pub witness: Vec<[f64; 3]>,
+}
+
+/// The 3D scene: the body mesh and the replay.
+#[derive(Serialize)]
+pub struct Scene {
+    pub lattice: LatticeKind,
+    /// `[positions, normals, indices]` of one body, flattened.
+    pub body: (Vec<f32>, Vec<f32>, Vec<u32>),
+    /// Whether the body is the catom (else a cube of the lattice spacing).
+    pub catom: bool,
+    pub ground: Option<f64>,
+    pub replay: replay::Replay,
+}
+
+fn finding(v: &Violation, lattice: LatticeKind) -> Finding {
+    let centre = |c: &Cell| lattice.lattice().centre(*c).to_array();
+    let witness = ["witness_mover", "witness_other"]
+        .iter()
+        .filter_map(|k| v.detail.get(*k))
+        .filter_map(|w| serde_json::from_value::<[f64; 3]>(w.clone()).ok())
+        .collect();
+    Finding {
+        step: v.step,
+        kind: v.kind.name(),
+        severity: v.severity,
+        message: v.message.clone(),
+        modules: v.modules.clone(),
+        cells: v.cells.iter().map(centre).collect(),
+        witness,
+    }
+}
+
+fn scene(s: &Schedule) -> Scene {
+    let catom = s.lattice == LatticeKind::Fcc;
+    let body = if catom {
+        let detail = if s.modules.len() + s.final_module_count() < 2 * DETAILED_BELOW {
+            3
+        } else {
+            2
+        };
+        let m = crate::geometry::catom().surface_mesh(detail);
+        (
+            m.positions.concat(),
+            m.normals.concat(),
+            m.triangles.concat(),
+        )
+    } else {
+        (Vec::new(), Vec::new(), Vec::new())
+    };
+    let lattice = s.lattice.lattice();
+    Scene {
+        lattice: s.lattice,
+        body,
+        catom,
+        ground: s
+            .ground
+            .map(|g| lattice.centre(Cell::new(0, 0, g.layer)).z - 0.5),
+        replay: replay::encode(s),
+    }
+}
+
+impl Page<'_> {
+    /// The data the viewer reads.
+    pub fn data(&self) -> PageData<'_> {
+        let lattice = self
+            .schedule
+            .map(|s| s.lattice)
+            .or(self.report.map(|r| r.lattice))
+            .unwrap_or(LatticeKind::Fcc);
+        let summary = self.report.map(|r| {
+            let (checked, not_checked) = r.coverage();
+            Summary {
+                certified: r.certified,
+                schedule: r.schedule.clone(),
+                lattice: r.lattice.name().to_string(),
+                modules: r.modules,
+                final_modules: r.final_modules,
+                steps: r.steps,
+                moves: r.moves,
+                checked,
+                not_checked,
+                stopped_at: r.stopped_at,
+            }
+        });
+        let (violations, warnings, warnings_total) = match self.report {
+            Some(r) => (
+                r.violations
+                    .iter()
+                    .take(MAX_LISTED)
+                    .map(|v| finding(v, lattice))
+                    .collect(),
+                r.warnings
+                    .iter()
+                    .take(MAX_LISTED)
+                    .map(|v| finding(v, lattice))
+                    .collect(),
+                r.warnings.len(),
+            ),
+            None => (Vec::new(), Vec::new(), 0),
+        };
+        let warning_counts = self
+            .report
+            .map(|r| {
+                r.warning_counts()
+                    .into_iter()
+                    .map(|((k, s), n)| (k.name(), s, n))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let violation_counts = self
+            .report
+            .map(|r| {
+                r.violation_counts()
+                    .into_iter()
+                    .map(|(k, n)| (k.name(), n))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let mut metrics: Vec<(String, Vec<Option<f64>>)> = Vec::new();
+        if let Some(r) = self.report {
+            let mut names: Vec<&String> =
+                r.per_step.iter().flat_map(|s| s.metrics.keys()).collect();
+            names.sort();
+            names.dedup();
+            for name in names {
+                let values = r
+                    .per_step
+                    .iter()
+                    .map(|s| s.metrics.get(name).copied().filter(|v| v.is_finite()))
+                    .collect();
+                metrics.push((name.clone(), values));
+            }
+        }
+        PageData {
+            title: &self.title,
+            generator: format!("reconfcheck {}", env!("CARGO_PKG_VERSION")),
+            summary,
+            violations,
+            warnings,
+            warnings_total,
+            warning_counts,
+            violation_counts,
+            metrics,
+            replay: self.schedule.map(scene),
+            load_maps: &self.load_maps,
+            study: self.study,
+        }
+    }
+
+    /// The page: one HTML document with three.js, the viewer, the style
+    /// and the data inlined; it loads nothing from anywhere.
+    pub fn html(&self) -> String {
+        let data = serde_json::to_string(&self.data()).expect("page data serialises");
+        let mut out = String::with_capacity(data.len() + THREE_JS.len() + 64 * 1024);
+        out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+        out.push_str(
+            "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; \
+             script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data: blob:\">\n",
+        );
+        out.push_str(&format!("<title>{}</title>\n", escape(&self.title)));
+        // Before anything else runs: count console errors and uncaught
+        // exceptions, so that the status line reports them.
+        out.push_str(
+            "<script>window.__errors=[];(function(){const e=console.error;\
+             console.error=function(...a){window.__errors.push(a.join(' '));e.apply(console,a);};\
+             addEventListener('error',ev=>window.__errors.push(String(ev.message)));})();</script>\n",
+        );
+        out.push_str("<style>\n");
+        out.push_str(STYLE_CSS);
+        out.push_str("</style>\n</head>\n<body>\n");
+        out.push_str(&format!(
+            "<header><h1>{}</h1><div id=\"status\">loading…</div></header>\n<main id=\"app\"></main>\n",
+            escape(&self.title)
+        ));
+        out.push_str("<script type=\"application/json\" id=\"reconfcheck-data\">");
+        out.push_str(&json_in_script(&data));
+        out.push_str("</script>\n<script>\n/* three.js r160 — ");
+        out.push_str(&THREE_LICENSE.replace("*/", "* /"));
+        out.push_str(" */\n");
+        out.push_str(&script_safe(THREE_JS));
+        out.push_str("\n</script>\n<script>\n");
+        out.push_str(VIEWER_JS);
+        out.push_str("\n</script>\n</body>\n</html>\n");
+        out
+    }
+}
+
+/// Text for an HTML element.
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Text that cannot end the `<script>` element it is inlined in.
+fn script_safe(s: &str) -> String {
+    s.replace("</", "<\\/")
+}
+
+/// JSON that cannot end or alter the `<script>` element it is inlined in:
+/// every `<` (only ever inside a string) written as `\u003c`, which any
+/// JSON parser reads back as `<`.
+fn json_in_script(s: &str) -> String {
+    s.replace('<', "\\u003c")
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,184 @@
+use super::*;
+use crate::certify::{self, Options, World};
+use std::collections::HashMap;
+use std::path::Path;
+
+fn scaffold() -> Schedule {
+    let sc = crate::scenario::Scenario::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/pyramid-h2-b8.toml"),
+    )
+    .unwrap();
+    crate::algorithms::generate(&sc).unwrap()
+}
+
+/// The bundled walk's first steps with a fixed module at (1, −1, 1), which
+/// its first rotation cuts (as `tests/common`'s obstacle walk).
+fn colliding_walk() -> Schedule {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"),
+    )
+    .unwrap();
+    let mut s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    s["steps"].as_array_mut().unwrap().truncate(3);
+    s["modules"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({"id": 900, "cell": [1, -1, 1], "fixed": true}));
+    Schedule::from_json(&s.to_string(), Path::new("walk.json")).unwrap()
+}
+
+/// The JSON object inlined in a page, read back.
+fn inlined(html: &str) -> serde_json::Value {
+    let open = "<script type=\"application/json\" id=\"reconfcheck-data\">";
+    let start = html.find(open).expect("the page inlines its data") + open.len();
+    let end = start + html[start..].find("</script>").unwrap();
+    serde_json::from_str(&html[start..end].replace("<\\/", "</")).unwrap()
+}
+
+#[test]
+fn the_inlined_replay_gives_the_schedules_configuration_at_every_step() {
+    let s = scaffold();
+    assert!(
+        s.steps.iter().any(|st| st
+            .events
+            .iter()
+            .any(|e| matches!(e, crate::schedule::Event::Enter { .. }))),
+        "the case has modules entering"
+    );
+    let html = Page {
+        title: "scaffold".into(),
+        schedule: Some(&s),
+        ..Default::default()
+    }
+    .html();
+    let replay: replay::Replay =
+        serde_json::from_value(inlined(&html)["replay"]["replay"].clone()).unwrap();
+    let mut world = World::initial(&s).unwrap();
+    let config = |w: &World| -> HashMap<u32, Cell> { w.config().iter().collect() };
+    assert_eq!(replay.cells_after(0), config(&world));
+    for k in 0..s.steps.len() {
+        certify::advance(&mut world, &s, k, |_| ()).unwrap();
+        assert_eq!(
+            replay.cells_after(k + 1),
+            config(&world),
+            "after step {}",
+            k + 1
+        );
+    }
+}
+
+#[test]
+fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
+    let s = colliding_walk();
+    let report = certify::certify(&s, &Options::default()).unwrap();
+    let collisions: Vec<&Violation> = report
+        .violations
+        .iter()
+        .filter(|v| v.kind == crate::certify::ViolationKind::Collision)
+        .collect();
+    assert!(!collisions.is_empty(), "the obstacle is cut");
+    let html = Page {
+        title: "walk".into(),
+        report: Some(&report),
+        schedule: Some(&s),
+        ..Default::default()
+    }
+    .html();
+    let data = inlined(&html);
+    let shown = data["violations"].as_array().unwrap();
+    assert_eq!(shown.len(), report.violations.len());
+    for (v, p) in report.violations.iter().zip(shown) {
+        assert_eq!(p["step"], v.step);
+        assert_eq!(p["kind"], v.kind.name());
+        assert_eq!(p["modules"], serde_json::json!(v.modules));
+        assert_eq!(p["cells"].as_array().unwrap().len(), v.cells.len());
+    }
+    for (v, p) in report.violations.iter().zip(shown) {
+        if v.kind != crate::certify::ViolationKind::Collision {
+            continue;
+        }
+        let witness: Vec<[f64; 3]> = serde_json::from_value(p["witness"].clone()).unwrap();
+        assert_eq!(witness.len(), 2);
+        assert_eq!(serde_json::json!(witness[0]), v.detail["witness_mover"]);
+        assert_eq!(serde_json::json!(witness[1]), v.detail["witness_other"]);
+    }
+    // The summary says what was checked.
+    assert_eq!(data["summary"]["certified"], false);
+    assert!(
+        data["summary"]["checked"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c.as_str().unwrap().starts_with("collision"))
+    );
+}
+
+#[test]
+fn the_page_loads_nothing_from_the_network() {
+    let s = colliding_walk();
+    let html = Page {
+        title: "walk".into(),
+        schedule: Some(&s),
+        ..Default::default()
+    }
+    .html();
+    let lower = html.to_lowercase();
+    for loader in [
+        "src=\"http",
+        "href=\"http",
+        "<link",
+        "<img",
+        "<iframe",
+        "url(http",
+    ] {
+        assert!(
+            !lower.contains(loader),
+            "the page loads something: {loader}"
+        );
+    }
+    // And the browser is told to refuse any load.
+    assert!(html.contains("default-src 'none'"));
+    assert!(html.contains(THREE_JS), "three.js is inlined whole");
+}
+
+#[test]
+fn text_that_would_end_a_script_element_stays_inside_the_data() {
+    let s = colliding_walk();
+    let mut report = certify::certify(&s, &Options::lattice_only()).unwrap();
+    report.schedule = "evil</script><script>alert(1)</script>.json".into();
+    let title = "a <b> & </script>";
+    let html = Page {
+        title: title.into(),
+        report: Some(&report),
+        ..Default::default()
+    }
+    .html();
+    // Four script elements, each closed once, and nothing opened in the data.
+    assert_eq!(
+        html.matches("</script>").count(),
+        4,
+        "no script was ended early"
+    );
+    assert_eq!(html.matches("<script").count(), 4, "no script was injected");
+    let data = inlined(&html);
+    assert_eq!(data["summary"]["schedule"], report.schedule.as_str());
+    assert_eq!(data["title"], title);
+}
+
+#[test]
+fn a_load_map_colours_every_connector_by_its_utilisation() {
+    let s = scaffold();
+    let model = crate::mechanics::Model::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"),
+    )
+    .unwrap();
+    let last = s.steps.len() + 1;
+    let maps = certify::load_maps_at(&s, &model, &[3, last]).unwrap();
+    assert_eq!(maps.iter().map(|m| m.0).collect::<Vec<_>>(), [3, last]);
+    let (step, st, a) = &maps[1];
+    let m = load_map(*step, st, a);
+    assert_eq!(m.links.len(), st.links.len());
+    assert!(!m.links.is_empty());
+    let top = m.links.iter().map(|l| l[6]).fold(0f32, f32::max);
+    assert!((top as f64 - a.max_utilisation).abs() < 1e-5 * a.max_utilisation.max(1.0));
+}
