@@ -462,7 +462,8 @@ impl AtomState {
         for l in loads {
             let u = l.force / m.strength;
             worst = if u.is_nan() { f64::NAN } else { worst.max(u) };
-            if !(u <= 1.0) {
+            // The one overload predicate: a NaN or infinite load fails.
+            if crate::mechanics::overloaded(u) {
                 let (a, b) = held[l.bond];
                 out.violations.push(
                     Violation::new(

@@ -364,6 +364,9 @@ pub fn meta_atoms_2d(mx: i32, my: i32, sp: i32) -> [Cell; 4] {
         .map(|(i, j)| Cell::new((2 * mx + i) * sp, (2 * my + j) * sp, 0))
 }
 
+/// A meta-module's label, its cell before and its cell after the move.
+type MetaPlace = (char, (i32, i32), (i32, i32));
+
 /// The labelled scene of a SLIDE in a 2D slice: the slider A at meta cell
 /// (1, 1) slides −x along the wall B (1, 0) onto C (0, 0). Carried
 /// meta-modules: D behind A (2, 1), E on A's far side from the wall
@@ -376,7 +379,7 @@ pub fn meta_atoms_2d(mx: i32, my: i32, sp: i32) -> [Cell; 4] {
 /// problem and, for each atom, its meta-module's label.
 pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, Vec<char>) {
     let sp = rest_spacing(rest);
-    let mut metas: Vec<(char, (i32, i32), (i32, i32))> = vec![
+    let mut metas: Vec<MetaPlace> = vec![
         ('B', (1, 0), (1, 0)),
         ('C', (0, 0), (0, 0)),
         ('A', (1, 1), (0, 1)),

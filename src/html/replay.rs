@@ -76,7 +76,8 @@ pub fn encode(s: &Schedule) -> Replay {
                     Some((*from, *to))
                 }
                 Event::Tunnel { path, .. } => path.first().zip(path.last()).map(|(a, b)| (*a, *b)),
-                Event::Enter { module, cell } => {
+                // A docking is drawn as its arrival in the cell.
+                Event::Enter { module, cell } | Event::Dock { module, cell, .. } => {
                     let i = instance(*module, &mut ids);
                     enters.extend([i, cell.x, cell.y, cell.z]);
                     None
@@ -85,7 +86,12 @@ pub fn encode(s: &Schedule) -> Replay {
                     leaves.push(instance(*module, &mut ids));
                     None
                 }
-                Event::Attach { .. } | Event::Detach { .. } => None,
+                // Face states of cube atoms move no cell: the replay shows
+                // the atoms' cells, not their arms.
+                Event::Attach { .. }
+                | Event::Detach { .. }
+                | Event::Expand { .. }
+                | Event::Contract { .. } => None,
             };
             if let Some((from, to)) = motion {
                 let i = instance(e.module(), &mut ids);
