@@ -53,7 +53,6 @@ fn sweep_checks(c: &mut Criterion) {
                 let input = SweepInput {
                     lattice: &FccLattice,
                     config: &config,
-                    ground: None,
                     moves: &moves,
                     moving: &moving,
                     epsilon: reconfcheck::geometry::Tolerance::DEFAULT,

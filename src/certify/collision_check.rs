@@ -3,7 +3,7 @@
 
 use super::report::{Severity, Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
-use crate::geometry::{Contact, ContactKind, Obstacle, SweepInput, SweepModel};
+use crate::geometry::{Contact, ContactKind, SweepInput, SweepModel};
 use crate::lattice::Motion;
 
 /// Runs a sweep model on every step.
@@ -26,7 +26,6 @@ impl StepCheck for CollisionCheck {
         let input = SweepInput {
             lattice: ctx.world.lattice(),
             config: ctx.world.config(),
-            ground: ctx.world.ground(),
             moves: &moves,
             moving: &ctx.plan.moving,
             epsilon: self.epsilon,
@@ -48,9 +47,9 @@ impl StepCheck for CollisionCheck {
 }
 
 /// The violation (or warning) of one contact, with the cells it concerns:
-/// the mover's start and target cells (its link), then the other body's
-/// cell at the start of the step (a module's, or the ground cell the mover
-/// entered); the pivot's cell and the route are in the details.
+/// the mover's start and target cells (its link), then the other module's
+/// cell at the start of the step; the pivot's cell and the route are in the
+/// details.
 fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
     let step = ctx.plan.step;
     let config = ctx.world.config();
@@ -68,22 +67,17 @@ fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
         kind,
         step,
         format!(
-            "module {} {what} {} at s = {:.4} (depth {:.3e} d)",
+            "module {} {what} module {} at s = {:.4} (depth {:.3e} d)",
             c.mover, c.other, c.s, c.depth
         ),
     )
-    .modules(std::iter::once(c.mover).chain(c.other.module()))
+    .modules([c.mover, c.other])
     .cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten())
-    .cells(c.other.cell(config))
+    .cells(config.cell_of(c.other))
     .detail("s", c.s)
     .detail("depth", c.depth)
     .detail("witness_mover", c.witness_mover.to_array())
     .detail("witness_other", c.witness_other.to_array());
-    // A ground contact says so (a module contact is the default reading).
-    let v = match c.other {
-        Obstacle::Ground(_) => v.detail("obstacle", "ground"),
-        Obstacle::Module(_) => v,
-    };
     match motion {
         Some(Motion::Rotate { pivot, route, .. }) => {
             v.detail("pivot_cell", pivot).detail("route", route)
@@ -92,97 +86,5 @@ fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
             pivot: Some(pivot), ..
         }) => v.detail("pivot_cell", pivot),
         _ => v,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::certify::{Options, ViolationKind, certify};
-    use crate::geometry::rolling::links;
-    use crate::lattice::{Cell, FccLattice, Ground, Lattice, LatticeKind};
-    use crate::schedule::units::Length;
-    use crate::schedule::{Event, ModuleSpec, Schedule, Step};
-
-    /// A fixed pivot at `pivot` and a mover rolling by `link`, on a
-    /// ground at layer 0 or without one.
-    fn roll(pivot: Cell, link: crate::geometry::rolling::Link, ground: bool) -> Schedule {
-        let l = FccLattice;
-        let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
-        s.ground = ground.then_some(Ground { layer: 0 });
-        let (from, to) = (
-            l.neighbour(pivot, link.from as usize),
-            l.neighbour(pivot, link.to as usize),
-        );
-        s.modules = vec![
-            ModuleSpec {
-                id: 0,
-                cell: pivot,
-                fixed: true,
-            },
-            ModuleSpec {
-                id: 1,
-                cell: from,
-                fixed: false,
-            },
-        ];
-        s.steps = vec![Step {
-            events: vec![Event::Rotate {
-                module: 1,
-                pivot: 0,
-                from,
-                to,
-                route: link.route,
-            }],
-        }];
-        s
-    }
-
-    /// End to end: a roll along the ground layer that dips into the
-    /// ground is a collision naming the ground and its cell, not a module;
-    /// the very same roll with no ground below is clear.
-    #[test]
-    fn a_roll_that_dips_into_the_ground_is_a_collision_with_the_ground() {
-        let l = FccLattice;
-        let pivot = Cell::new(0, 0, 0);
-        let mut dipped = 0;
-        for link in links() {
-            let (from, to) = (
-                l.neighbour(pivot, link.from as usize),
-                l.neighbour(pivot, link.to as usize),
-            );
-            if l.layer(from) != 0 || l.layer(to) != 0 {
-                continue;
-            }
-            let with = certify(&roll(pivot, link, true), &Options::default()).unwrap();
-            let hits: Vec<_> = with
-                .violations
-                .iter()
-                .filter(|v| v.kind == ViolationKind::Collision)
-                .collect();
-            if hits.is_empty() {
-                continue;
-            }
-            dipped += 1;
-            for v in &hits {
-                assert!(v.message.contains("the ground (cell"), "{}", v.message);
-                assert_eq!(v.modules, vec![1], "only the mover is named");
-                assert_eq!(v.detail["obstacle"], "ground");
-                let cell = *v.cells.last().unwrap();
-                assert!(
-                    l.layer(cell) < 0,
-                    "the blocking cell {cell} is below the ground"
-                );
-            }
-            let without = certify(&roll(pivot, link, false), &Options::default()).unwrap();
-            assert!(
-                without
-                    .violations
-                    .iter()
-                    .all(|v| v.kind != ViolationKind::Collision),
-                "{link:?}: {:?}",
-                without.violations
-            );
-        }
-        assert!(dipped > 0, "no roll along the ground dips into it");
     }
 }

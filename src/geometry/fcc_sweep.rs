@@ -14,7 +14,7 @@
 use super::rolling::{Link, Roll};
 use super::rules::{offsets_within_reach, table};
 use super::sweep::{PairOutcome, Path, Sample, sweep_pair};
-use super::{Contact, ContactKind, EPSILON, Obstacle, SweepInput, SweepModel};
+use super::{Contact, ContactKind, EPSILON, SweepInput, SweepModel};
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Motion};
 use glam::DVec3;
@@ -50,7 +50,7 @@ fn swept_ball(link: Link) -> (DVec3, f64) {
     })[&link]
 }
 
-fn contact(kind: ContactKind, x: Sample, mover: ModuleId, other: Obstacle) -> Contact {
+fn contact(kind: ContactKind, x: Sample, mover: ModuleId, other: ModuleId) -> Contact {
     Contact {
         kind,
         s: x.s,
@@ -66,7 +66,7 @@ fn contact(kind: ContactKind, x: Sample, mover: ModuleId, other: Obstacle) -> Co
     }
 }
 
-fn outcome_contact(o: PairOutcome, mover: ModuleId, other: Obstacle) -> Option<Contact> {
+fn outcome_contact(o: PairOutcome, mover: ModuleId, other: ModuleId) -> Option<Contact> {
     match o {
         PairOutcome::Clear => None,
         PairOutcome::Sliding(x) => Some(contact(ContactKind::SlidingContact, x, mover, other)),
@@ -97,10 +97,10 @@ impl FccSweep {
         m: &Mover,
     ) -> Vec<Contact> {
         let others = |cell: Cell| {
-            Obstacle::at(input.config, input.ground, input.lattice, cell).filter(|o| match o {
-                Obstacle::Module(o) => *o != m.id && Some(*o) != m.pivot_id && !movers.contains(o),
-                Obstacle::Ground(_) => true,
-            })
+            input
+                .config
+                .at(cell)
+                .filter(|o| *o != m.id && Some(*o) != m.pivot_id && !movers.contains(o))
         };
         let mut out = Vec::new();
         if input.exact || table().tolerance() != input.epsilon {
@@ -145,8 +145,9 @@ impl FccSweep {
             out.retain(|c| {
                 c.kind != ContactKind::SlidingContact
                     || !m.ends.iter().any(|&e| {
-                        c.other
-                            .cell(input.config)
+                        input
+                            .config
+                            .cell_of(c.other)
                             .is_some_and(|q| input.lattice.are_neighbours(q, e))
                     })
             });
@@ -215,7 +216,7 @@ impl SweepModel for FccSweep {
         let pair_check = |&(i, j): &(usize, usize)| {
             let (a, b) = (&movers[i], &movers[j]);
             let sw = sweep_pair(&a.roll, &Path::Rolling(b.roll), input.epsilon.get());
-            outcome_contact(sw.outcome, a.id, Obstacle::Module(b.id))
+            outcome_contact(sw.outcome, a.id, b.id)
         };
         let mut out: Vec<Contact>;
         if movers.len() >= PARALLEL_MOVERS {
@@ -240,14 +241,13 @@ mod tests {
     use super::*;
     use crate::geometry::rolling::links;
     use crate::geometry::sweep::sweep_pair;
-    use crate::lattice::{Configuration, FccLattice, Ground, Lattice, Route};
+    use crate::lattice::{Configuration, FccLattice, Lattice, Route};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
     /// A scene: pivot (id 0), mover (id 1) and obstacles (ids 2..).
     struct Scene {
         config: Configuration,
-        ground: Option<Ground>,
         moves: Vec<(ModuleId, Option<ModuleId>, Motion)>,
         moving: FxHashSet<ModuleId>,
     }
@@ -270,7 +270,6 @@ mod tests {
         };
         Scene {
             config,
-            ground: None,
             moves: vec![(1, Some(0), motion)],
             moving: [1].into_iter().collect(),
         }
@@ -280,7 +279,6 @@ mod tests {
         let input = SweepInput {
             lattice: &FccLattice,
             config: &s.config,
-            ground: s.ground,
             moves: &s.moves,
             moving: &s.moving,
             epsilon: crate::geometry::Tolerance::DEFAULT,
@@ -291,82 +289,12 @@ mod tests {
         v
     }
 
-    fn kinds(v: &[Contact]) -> Vec<(ModuleId, Obstacle, ContactKind)> {
+    fn kinds(v: &[Contact]) -> Vec<(ModuleId, ModuleId, ContactKind)> {
         v.iter().map(|c| (c.mover, c.other, c.kind)).collect()
     }
 
     fn link(from: u8, to: u8, route: Route) -> Link {
         Link { from, to, route }
-    }
-
-    /// The collisions of `s`, as (obstacle, depth) sorted.
-    fn collisions(v: &[Contact]) -> Vec<(Obstacle, f64)> {
-        v.iter()
-            .filter(|c| c.kind == ContactKind::Collision)
-            .map(|c| (c.other, c.depth))
-            .collect()
-    }
-
-    /// The ground is the bodies of the cells below its layer, as the
-    /// mechanics models it. Independent reading: a roll on a ground-layer
-    /// pivot collides with the ground exactly where it collides with a
-    /// module standing alone in one of those cells, at the same depth —
-    /// exact sweeps and compiled table alike. Some rolls between cells
-    /// of the ground layer do dip into it (a certifier that ignored the
-    /// ground would pass them).
-    #[test]
-    fn the_ground_blocks_a_roll_as_a_module_in_each_ground_cell_would() {
-        let l = FccLattice;
-        let ground = Ground { layer: 0 };
-        let mut dipping = Vec::new();
-        for pivot in [Cell::new(0, 0, 0), Cell::new(3, 2, 1)] {
-            for link in links() {
-                let (from, to) = (
-                    l.neighbour(pivot, link.from as usize),
-                    l.neighbour(pivot, link.to as usize),
-                );
-                if ground.is_ground_cell(&l, from) || ground.is_ground_cell(&l, to) {
-                    continue;
-                }
-                let mut s = scene(pivot, link, &[]);
-                s.ground = Some(ground);
-                let mut want = Vec::new();
-                for off in offsets_within_reach() {
-                    let c = off.from(pivot);
-                    if ground.is_ground_cell(&l, c) {
-                        let alone = check(&scene(pivot, link, &[c]), true);
-                        want.extend(
-                            collisions(&alone)
-                                .into_iter()
-                                .map(|(_, d)| (Obstacle::Ground(c), d)),
-                        );
-                    }
-                }
-                for exact in [true, false] {
-                    let mut got = collisions(&check(&s, exact));
-                    got.sort_by(|a, b| a.partial_cmp(b).unwrap());
-                    want.sort_by(|a, b| a.partial_cmp(b).unwrap());
-                    assert_eq!(got.len(), want.len(), "{pivot} {link:?} exact {exact}");
-                    for (g, w) in got.iter().zip(&want) {
-                        assert_eq!(g.0, w.0);
-                        assert!((g.1 - w.1).abs() < 1e-12, "{g:?} {w:?}");
-                    }
-                }
-                if !want.is_empty() && l.layer(from) == 0 && l.layer(to) == 0 {
-                    dipping.push((pivot, link));
-                }
-            }
-        }
-        // Rolls between two ground-layer cells, about a pivot in the layer
-        // or above it, that dip into the ground.
-        assert!(
-            dipping.iter().any(|(p, _)| l.layer(*p) == 0),
-            "no roll about a ground-layer pivot meets the ground"
-        );
-        assert!(
-            dipping.iter().any(|(p, _)| l.layer(*p) == 1),
-            "no roll over a pivot above the ground meets it"
-        );
     }
 
     #[test]
@@ -389,10 +317,7 @@ mod tests {
         );
         for exact in [true, false] {
             let c = check(&s, exact);
-            assert_eq!(
-                kinds(&c),
-                vec![(1, Obstacle::Module(2), ContactKind::Collision)]
-            );
+            assert_eq!(kinds(&c), vec![(1, 2, ContactKind::Collision)]);
             let c = &c[0];
             assert!((c.depth - 0.6197).abs() < 1e-3, "{}", c.depth);
             assert!((c.s - 0.572).abs() < 5e-3, "{}", c.s);
@@ -592,17 +517,13 @@ mod tests {
             let input = SweepInput {
                 lattice: &l,
                 config: &config,
-                ground: None,
                 moves: &moves,
                 moving: &moving,
                 epsilon: crate::geometry::Tolerance::DEFAULT,
                 exact,
             };
             let c = FccSweep.check_step(&input);
-            assert_eq!(
-                kinds(&c),
-                vec![(1, Obstacle::Module(2), ContactKind::Collision)]
-            );
+            assert_eq!(kinds(&c), vec![(1, 2, ContactKind::Collision)]);
             assert!(c[0].depth > 0.5, "head-on: {}", c[0].depth);
         }
     }
@@ -635,7 +556,6 @@ mod tests {
         let input = SweepInput {
             lattice: &l,
             config: &config,
-            ground: None,
             moves: &moves,
             moving: &moving,
             epsilon: crate::geometry::Tolerance::DEFAULT,
@@ -646,11 +566,7 @@ mod tests {
             c.iter().all(|c| c.kind == ContactKind::SlidingContact),
             "{c:?}"
         );
-        assert!(
-            c.iter()
-                .any(|c| (c.mover, c.other) == (0, Obstacle::Module(1))),
-            "{c:?}"
-        );
+        assert!(c.iter().any(|c| (c.mover, c.other) == (0, 1)), "{c:?}");
     }
 
     /// A penetration of 2ε lasting a sliver of the sweep, straddled by the

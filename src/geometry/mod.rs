@@ -15,7 +15,7 @@ pub(crate) mod rules;
 pub(crate) mod sweep;
 
 use crate::lattice::config::ModuleId;
-use crate::lattice::{Cell, Configuration, Ground, Lattice, LatticeKind, Motion};
+use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
 use glam::DVec3;
 use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
@@ -79,10 +79,6 @@ pub struct SweepInput<'a> {
     pub lattice: &'a dyn Lattice,
     /// Occupancy at the start of the step (movers at their start cells).
     pub config: &'a Configuration,
-    /// The solid ground, if the scene has one: every cell below its layer
-    /// is a static body, as the mechanics models it (a ground-layer module
-    /// touches the ground through the connectors facing the cells below).
-    pub ground: Option<Ground>,
     /// The moves of the step: mover, its pivot (if any) and its motion.
     pub moves: &'a [(ModuleId, Option<ModuleId>, Motion)],
     /// Modules that do not stay put during the step.
@@ -102,66 +98,13 @@ pub struct Contact {
     pub s: f64,
     /// The mover.
     pub mover: ModuleId,
-    /// What the mover met: another module (static, or a mover), or the
-    /// ground.
-    pub other: Obstacle,
+    /// The other module (static, or another mover).
+    pub other: ModuleId,
     /// Penetration depth in units of d (0 for sliding contact).
     pub depth: f64,
     /// Witness points on each body, world frame, units of d.
     pub witness_mover: DVec3,
     pub witness_other: DVec3,
-}
-
-/// The body a mover meets.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Obstacle {
-    Module(ModuleId),
-    /// The ground, in the body of one of its cells (a cell below the
-    /// ground layer).
-    Ground(Cell),
-}
-
-impl Obstacle {
-    /// The module, if the obstacle is one.
-    pub fn module(self) -> Option<ModuleId> {
-        match self {
-            Obstacle::Module(m) => Some(m),
-            Obstacle::Ground(_) => None,
-        }
-    }
-
-    /// The obstacle's cell at the start of the step.
-    pub fn cell(self, config: &Configuration) -> Option<Cell> {
-        match self {
-            Obstacle::Module(m) => config.cell_of(m),
-            Obstacle::Ground(c) => Some(c),
-        }
-    }
-
-    /// What occupies `cell` as an obstacle: its module, else the ground.
-    pub fn at(
-        config: &Configuration,
-        ground: Option<Ground>,
-        lattice: &dyn Lattice,
-        cell: Cell,
-    ) -> Option<Obstacle> {
-        match config.at(cell) {
-            Some(m) => Some(Obstacle::Module(m)),
-            None => ground
-                .filter(|g| g.is_ground_cell(lattice, cell))
-                .map(|_| Obstacle::Ground(cell)),
-        }
-    }
-}
-
-impl std::fmt::Display for Obstacle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Obstacle::Module(m) => write!(f, "module {m}"),
-            Obstacle::Ground(c) => write!(f, "the ground (cell {c})"),
-        }
-    }
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]

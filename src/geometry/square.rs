@@ -28,7 +28,7 @@
 //! corners and contacts without relative motion (a column of movers sliding
 //! together) are not reported.
 
-use super::{Contact, ContactKind, Obstacle, SweepInput, SweepModel};
+use super::{Contact, ContactKind, SweepInput, SweepModel};
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Motion};
 use glam::{DVec2, DVec3};
@@ -167,7 +167,7 @@ fn sweep_pair(a: &Path, b: &Path, eps: f64) -> PairResult {
 fn contact(
     kind: ContactKind,
     mover: ModuleId,
-    other: Obstacle,
+    other: ModuleId,
     s: f64,
     depth: f64,
     a: &Path,
@@ -203,7 +203,7 @@ impl SweepModel for SquareSweep {
         let mut out = Vec::new();
         let mut report = |r: PairResult,
                           mover: ModuleId,
-                          other: Obstacle,
+                          other: ModuleId,
                           expected: bool,
                           a: &Path,
                           b: &Path| {
@@ -244,14 +244,10 @@ impl SweepModel for SquareSweep {
             for dx in -2..=2 {
                 for dy in -2..=2 {
                     let c = Cell::xy(from.x + dx, from.y + dy);
-                    let Some(other) = Obstacle::at(input.config, input.ground, input.lattice, c)
-                    else {
+                    let Some(other) = input.config.at(c) else {
                         continue;
                     };
-                    if other
-                        .module()
-                        .is_some_and(|o| o == *id || input.moving.contains(&o))
-                    {
+                    if other == *id || input.moving.contains(&other) {
                         continue;
                     }
                     let expected = Some(c) == pivot_cell || wall.contains(&c);
@@ -271,14 +267,7 @@ impl SweepModel for SquareSweep {
             for (b_id, _, b) in &movers[i + 1..] {
                 let near = (a.at(0.0) - b.at(0.0)).abs().max_element() <= 4.0;
                 if near {
-                    report(
-                        sweep_pair(a, b, eps),
-                        *a_id,
-                        Obstacle::Module(*b_id),
-                        false,
-                        a,
-                        b,
-                    );
+                    report(sweep_pair(a, b, eps), *a_id, *b_id, false, a, b);
                 }
             }
         }
@@ -321,7 +310,6 @@ mod tests {
         let input = SweepInput {
             lattice: &SquareLattice,
             config: &config,
-            ground: None,
             moves: &list,
             moving: &moving,
             epsilon: crate::geometry::Tolerance::DEFAULT,
@@ -352,7 +340,7 @@ mod tests {
             (c[0].depth - 1.0).abs() < 1e-12 && (c[0].s - 1.0).abs() < 1e-12,
             "{c:?}"
         );
-        assert_eq!(c[0].other, Obstacle::Module(102));
+        assert_eq!(c[0].other, 102);
     }
 
     #[test]
@@ -387,12 +375,7 @@ mod tests {
                 .all(|c| c.kind == ContactKind::SlidingContact && c.depth == 0.0)
         );
         let others: FxHashSet<_> = c.iter().map(|c| c.other).collect();
-        assert_eq!(
-            others,
-            [Obstacle::Module(102), Obstacle::Module(103)]
-                .into_iter()
-                .collect()
-        );
+        assert_eq!(others, [102, 103].into_iter().collect());
     }
 
     #[test]
