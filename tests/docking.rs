@@ -236,14 +236,9 @@ fn rule1_is_never_looser_than_the_geometry_on_the_square_lattice() {
             config.insert(k as u32, Cell::xy(x, y)).unwrap();
         }
         let rule1_allows = !blocked_2d(&|x, y| occ.contains(&(x, y)), 0, 0);
-        let geometry_allows = !clear_approaches(
-            &SquareLattice,
-            &config,
-            None,
-            Cell::xy(0, 0),
-            Tolerance::DEFAULT,
-        )
-        .is_empty();
+        let geometry_allows =
+            !clear_approaches(&SquareLattice, &config, Cell::xy(0, 0), Tolerance::DEFAULT)
+                .is_empty();
         if rule1_allows && !geometry_allows {
             looser += 1;
         }

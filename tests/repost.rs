@@ -125,18 +125,23 @@ fn the_bundled_operation_scenario_certifies_clean_with_sweeps_and_mechanics() {
     assert!(out.contains("158 moves"), "{out}");
 }
 
-/// A shape file with a cell off the meta-module lattice is unusable input:
-/// exit 2, naming the file and the cell.
-#[test]
-fn a_shape_cell_off_the_meta_module_lattice_exits_2_naming_file_and_cell() {
-    let dir = std::env::temp_dir().join(format!("repost-bad-{}", std::process::id()));
+/// Generates a `repost` scenario over the shape files `shapes` (name,
+/// text), written to a fresh folder `tag`: its exit code and stderr.
+fn generate_repost(
+    tag: &str,
+    shapes: &[(&str, &str)],
+    initial: &str,
+    goal: &str,
+) -> (Option<i32>, String) {
+    let dir = std::env::temp_dir().join(format!("repost-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("bad.txt"), "0 0 0\n4 1 0\n").unwrap();
-    std::fs::write(dir.join("good.txt"), "0 0 0\n4 0 0\n").unwrap();
+    for (name, text) in shapes {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
     let sc = dir.join("s.toml");
     std::fs::write(
         &sc,
-        "name = \"bad\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"good.txt\"\ngoal = \"bad.txt\"\n",
+        format!("name = \"{tag}\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"{initial}\"\ngoal = \"{goal}\"\n"),
     )
     .unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
@@ -144,8 +149,22 @@ fn a_shape_cell_off_the_meta_module_lattice_exits_2_naming_file_and_cell() {
         .arg(dir.join("out.json"))
         .output()
         .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A shape file with a cell off the meta-module lattice is unusable input:
+/// exit 2, naming the file and the cell.
+#[test]
+fn a_shape_cell_off_the_meta_module_lattice_exits_2_naming_file_and_cell() {
+    let shapes = [
+        ("bad.txt", "0 0 0\n4 1 0\n"),
+        ("good.txt", "0 0 0\n4 0 0\n"),
+    ];
+    let (code, err) = generate_repost("bad", &shapes, "good.txt", "bad.txt");
+    assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("bad.txt") && err.contains("(4, 1, 0)"),
         "{err}"
@@ -156,22 +175,11 @@ fn a_shape_cell_off_the_meta_module_lattice_exits_2_naming_file_and_cell() {
 /// goal outside the ⌈N/20⌉ ≤ S_G ≤ N/10 bound) is refused with exit 2.
 #[test]
 fn a_goal_outside_the_compression_bound_exits_2_naming_the_bound() {
-    let dir = std::env::temp_dir().join(format!("repost-bound-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("one.txt"), "0 0 0\n").unwrap();
-    std::fs::write(dir.join("three.txt"), "0 0 0\n4 0 0\n8 0 0\n").unwrap();
-    let sc = dir.join("s.toml");
-    std::fs::write(
-        &sc,
-        "name = \"b\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"one.txt\"\ngoal = \"three.txt\"\n",
-    )
-    .unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
-        .args(["generate", sc.to_str().unwrap(), "-o"])
-        .arg(dir.join("out.json"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let shapes = [
+        ("one.txt", "0 0 0\n"),
+        ("three.txt", "0 0 0\n4 0 0\n8 0 0\n"),
+    ];
+    let (code, err) = generate_repost("bound", &shapes, "one.txt", "three.txt");
+    assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("three.txt") && err.contains("N/10"), "{err}");
 }

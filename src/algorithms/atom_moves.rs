@@ -74,25 +74,7 @@ pub fn atom_schedule(scene: &Scene, steps: &[Vec<Op>], rest: AtomRest, what: &st
 
 /// The schedule event of one operation (atom `a` is module `a`).
 pub fn event_of(op: Op) -> Event {
-    let id = |a: usize| a as ModuleId;
-    match op {
-        Op::Expand(a, face) => Event::Expand {
-            module: id(a),
-            face,
-        },
-        Op::Contract(a, face) => Event::Contract {
-            module: id(a),
-            face,
-        },
-        Op::Attach(a, b) => Event::Attach {
-            module: id(a),
-            other: id(b),
-        },
-        Op::Detach(a, b) => Event::Detach {
-            module: id(a),
-            other: id(b),
-        },
-    }
+    op.event(|a| a as ModuleId, |f| f)
 }
 
 /// The face names of a sequence, for reading a derived move.

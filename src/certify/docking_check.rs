@@ -70,11 +70,11 @@ impl StepCheck for DockingCheck {
                 pivot: pivot_cell,
                 motion: d.motion.clone(),
             };
-            let verdict = judge(lattice, config, w.ground(), &approach, self.epsilon);
+            let verdict = judge(lattice, config, &approach, self.epsilon);
             if verdict.is_clear() && !plan.moving.contains(&d.pivot) {
                 continue;
             }
-            let others = clear_approaches(lattice, config, w.ground(), cell, self.epsilon);
+            let others = clear_approaches(lattice, config, cell, self.epsilon);
             let mut cells = verdict.blocking.clone();
             cells.extend(verdict.missing_supports.iter().copied());
             let mut why = Vec::new();

@@ -315,15 +315,18 @@ mod tests {
         let (s, d) = first_overlap(&a, &b, 1e-6).unwrap();
         assert!((s - 0.5).abs() < 1e-9, "s = {s}");
         assert!((d - 1.0).abs() < 1e-9);
-        // Mirror image.
-        let m = |x: [f64; 3]| [-x[0], x[1], x[2]];
+        // Mirror image in x: the low x corner is the mirrored high one,
+        // y and z stay as they are. Same instant, same depth.
+        let lo = |l: [f64; 3], h: [f64; 3]| [-h[0], l[1], l[2]];
+        let hi = |l: [f64; 3], h: [f64; 3]| [-l[0], h[1], h[2]];
         let am = MovingBox {
-            lo0: m(a.hi0),
-            hi0: m(a.lo0),
-            lo1: m(a.hi1),
-            hi1: m(a.lo1),
+            lo0: lo(a.lo0, a.hi0),
+            hi0: hi(a.lo0, a.hi0),
+            lo1: lo(a.lo1, a.hi1),
+            hi1: hi(a.lo1, a.hi1),
         };
-        assert!(first_overlap(&am, &b, 1e-6).is_some());
+        let (sm, dm) = first_overlap(&am, &b, 1e-6).unwrap();
+        assert!((sm - s).abs() < 1e-9 && (dm - d).abs() < 1e-9, "{sm} {dm}");
     }
 
     #[test]

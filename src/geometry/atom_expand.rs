@@ -40,33 +40,33 @@ pub struct SlideLibrary {
 pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
-    let cell = match rest {
-        AtomRest::Contracted => &CONTRACTED,
-        AtomRest::Expanded => &EXPANDED,
-    };
-    cell.get_or_init(|| {
-        let problem = super::atom_search::double_slide_problem(rest);
-        let found = problem.solve()?;
-        let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
-        Some(SlideLibrary {
-            problem,
-            found,
-            steps,
-        })
+    library(rest, [&CONTRACTED, &EXPANDED], || {
+        super::atom_search::double_slide_problem(rest)
     })
-    .as_ref()
 }
 
 /// The library of `rest`, searched once per process.
 pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    library(rest, [&CONTRACTED, &EXPANDED], || {
+        slide_problem(rest, Carry::Both).0
+    })
+}
+
+/// Solves `problem` once per process and model (`cells`: the contracted
+/// and the expanded model's slot) and lifts the result to 3D.
+fn library(
+    rest: AtomRest,
+    cells: [&'static OnceLock<Option<SlideLibrary>>; 2],
+    problem: impl FnOnce() -> Problem,
+) -> Option<&'static SlideLibrary> {
     let cell = match rest {
-        AtomRest::Contracted => &CONTRACTED,
-        AtomRest::Expanded => &EXPANDED,
+        AtomRest::Contracted => cells[0],
+        AtomRest::Expanded => cells[1],
     };
     cell.get_or_init(|| {
-        let (problem, _) = slide_problem(rest, Carry::Both);
+        let problem = problem();
         let found = problem.solve()?;
         let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
         Some(SlideLibrary {
@@ -305,24 +305,7 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                 .iter()
                 .map(|st| {
                     st.iter()
-                        .map(|op| match *op {
-                            Op::Expand(a, f) => Event::Expand {
-                                module: atom(a),
-                                face: turn.face(f),
-                            },
-                            Op::Contract(a, f) => Event::Contract {
-                                module: atom(a),
-                                face: turn.face(f),
-                            },
-                            Op::Attach(a, b) => Event::Attach {
-                                module: atom(a),
-                                other: atom(b),
-                            },
-                            Op::Detach(a, b) => Event::Detach {
-                                module: atom(a),
-                                other: atom(b),
-                            },
-                        })
+                        .map(|op| op.event(atom, |f| turn.face(f)))
                         .collect()
                 })
                 .collect();

@@ -10,7 +10,9 @@
 //! schedules carry and what the certifier checks independently.
 
 use super::atom::{Bond, Faces, atom_boxes, contact_face, first_overlap, solve_step};
+use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Face};
+use crate::schedule::Event;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::{BTreeSet, VecDeque};
 
@@ -24,6 +26,29 @@ pub enum Op {
 }
 
 impl Op {
+    /// The schedule event of the operation, its atoms named by `id` and
+    /// its faces turned by `face` (the frame the operation is placed in).
+    pub fn event(self, id: impl Fn(usize) -> ModuleId, face: impl Fn(Face) -> Face) -> Event {
+        match self {
+            Op::Expand(a, f) => Event::Expand {
+                module: id(a),
+                face: face(f),
+            },
+            Op::Contract(a, f) => Event::Contract {
+                module: id(a),
+                face: face(f),
+            },
+            Op::Attach(a, b) => Event::Attach {
+                module: id(a),
+                other: id(b),
+            },
+            Op::Detach(a, b) => Event::Detach {
+                module: id(a),
+                other: id(b),
+            },
+        }
+    }
+
     /// The atoms the operation names.
     pub fn atoms(&self) -> (usize, Option<usize>) {
         match *self {

@@ -12,9 +12,9 @@
 //! ([`super::sweep_model`]) must penetrate no module. Rule 1 of the paper
 //! is not consulted here; it lives with the generator.
 
-use super::{Contact, ContactKind, Obstacle, SweepInput, Tolerance, sweep_model};
+use super::{Contact, ContactKind, SweepInput, Tolerance, sweep_model};
 use crate::lattice::config::ModuleId;
-use crate::lattice::{Cell, Configuration, Ground, Lattice, LatticeKind, Motion};
+use crate::lattice::{Cell, Configuration, Lattice, LatticeKind, Motion};
 use rustc_hash::FxHashSet;
 
 /// Cells around a mover's origin whose modules its sweep can touch.
@@ -96,7 +96,6 @@ impl Obstruction {
 pub fn judge(
     lattice: &'static dyn Lattice,
     config: &Configuration,
-    ground: Option<Ground>,
     approach: &Approach,
     epsilon: Tolerance,
 ) -> Obstruction {
@@ -109,10 +108,10 @@ pub fn judge(
         .supports
         .iter()
         .copied()
-        .filter(|c| Obstacle::at(config, ground, lattice, *c).is_none())
+        .filter(|c| config.is_free(*c))
         .collect();
     for c in std::iter::once(approach.from).chain(req.pass_through.iter().copied()) {
-        if Obstacle::at(config, ground, lattice, c).is_some() && !out.blocking.contains(&c) {
+        if !config.is_free(c) && !out.blocking.contains(&c) {
             out.blocking.push(c);
         }
     }
@@ -154,7 +153,6 @@ pub fn judge(
     let input = SweepInput {
         lattice,
         config: &scene,
-        ground,
         moves: &moves,
         moving: &moving,
         epsilon,
@@ -162,7 +160,7 @@ pub fn judge(
     };
     let contacts: Vec<Contact> = model.check_step(&input);
     for c in contacts.iter().filter(|c| c.kind == ContactKind::Collision) {
-        if let Some(cell) = c.other.cell(config)
+        if let Some(cell) = config.cell_of(c.other)
             && !out.blocking.contains(&cell)
         {
             out.blocking.push(cell);
@@ -175,13 +173,12 @@ pub fn judge(
 pub fn clear_approaches(
     lattice: &'static dyn Lattice,
     config: &Configuration,
-    ground: Option<Ground>,
     cell: Cell,
     epsilon: Tolerance,
 ) -> Vec<Approach> {
     candidates(lattice, cell)
         .into_iter()
-        .filter(|a| judge(lattice, config, ground, a, epsilon).is_clear())
+        .filter(|a| judge(lattice, config, a, epsilon).is_clear())
         .collect()
 }
 
@@ -206,7 +203,7 @@ mod tests {
     #[test]
     fn a_cell_beside_one_module_is_reached_around_its_corner() {
         let c = scene(&[(1, 0)]);
-        let ok = clear_approaches(&SquareLattice, &c, None, Cell::xy(0, 0), Tolerance::DEFAULT);
+        let ok = clear_approaches(&SquareLattice, &c, Cell::xy(0, 0), Tolerance::DEFAULT);
         assert!(ok.iter().any(|a| a.from == Cell::xy(1, 1)), "{ok:?}");
         // A module in the corner's passage blocks that approach.
         let c = scene(&[(1, 0), (0, 1)]);
@@ -214,7 +211,7 @@ mod tests {
             .into_iter()
             .find(|a| a.from == Cell::xy(1, 1) && a.pivot == Cell::xy(1, 0))
             .unwrap();
-        let o = judge(&SquareLattice, &c, None, &a, Tolerance::DEFAULT);
+        let o = judge(&SquareLattice, &c, &a, Tolerance::DEFAULT);
         assert_eq!(o.blocking, vec![Cell::xy(0, 1)]);
     }
 }

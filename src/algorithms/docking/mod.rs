@@ -119,7 +119,7 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         let id = k as ModuleId;
         let cell = Cell::xy(d.cell.0, d.cell.1);
         let attractor = d.attractor.map(|(x, y)| Cell::xy(x, y));
-        let clear = clear_approaches(lattice, &config, s.ground, cell, Tolerance::DEFAULT);
+        let clear = clear_approaches(lattice, &config, cell, Tolerance::DEFAULT);
         let pick = |list: &[Approach]| -> Option<Approach> {
             list.iter()
                 .find(|a| Some(a.pivot) == attractor)
