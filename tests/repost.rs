@@ -8,7 +8,8 @@ use reconfcheck::algorithms::repost::operations::{self, Role};
 use reconfcheck::certify::{Options, World, certify};
 use reconfcheck::lattice::Cell;
 use std::path::PathBuf;
-use std::process::Command;
+
+mod common;
 
 fn fill_name(fill: State) -> &'static str {
     if fill == State::Full {
@@ -106,7 +107,7 @@ fn every_derived_operation_replays_as_lattice_moves_and_fills_its_goal() {
 #[test]
 fn the_bundled_operation_scenario_certifies_clean_with_sweeps_and_mechanics() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+    let o = common::bin()
         .arg("run")
         .arg(root.join("scenarios/repost-operation.toml"))
         .output()
@@ -133,20 +134,18 @@ fn generate_repost(
     initial: &str,
     goal: &str,
 ) -> (Option<i32>, String) {
-    let dir = std::env::temp_dir().join(format!("repost-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     for (name, text) in shapes {
-        std::fs::write(dir.join(name), text).unwrap();
+        std::fs::write(common::scratch(tag, name), text).unwrap();
     }
-    let sc = dir.join("s.toml");
+    let sc = common::scratch(tag, "s.toml");
     std::fs::write(
         &sc,
         format!("name = \"{tag}\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"{initial}\"\ngoal = \"{goal}\"\n"),
     )
     .unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+    let o = common::bin()
         .args(["generate", sc.to_str().unwrap(), "-o"])
-        .arg(dir.join("out.json"))
+        .arg(common::scratch(tag, "out.json"))
         .output()
         .unwrap();
     (
