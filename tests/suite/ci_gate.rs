@@ -6,9 +6,9 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
+use crate::common;
 
-use common::bin;
+use crate::common::bin;
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch("ci", name)

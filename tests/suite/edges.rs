@@ -7,9 +7,9 @@ use serde_json::Value;
 use std::path::PathBuf;
 use std::process::Output;
 
-mod common;
+use crate::common;
 
-use common::{bin, walk_with_obstacle};
+use crate::common::{bin, walk_with_obstacle};
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch("edges", name)

@@ -1,8 +1,7 @@
 //! Property tests: random valid walks certify clean, and faults injected
 //! into them are caught exactly where an independent oracle says.
 
-mod common;
-use common::*;
+use crate::common::*;
 use proptest::prelude::*;
 use reconfcheck::algorithms::random_walk::{WalkParams, walk};
 use reconfcheck::certify::ViolationKind;

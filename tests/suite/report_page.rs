@@ -1,8 +1,8 @@
 //! `--html` and the summary's coverage lines, through the binary.
 
-mod common;
+use crate::common;
 
-use common::bin;
+use crate::common::bin;
 use std::path::Path;
 
 fn walk(name: &str) -> std::path::PathBuf {

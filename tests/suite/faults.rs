@@ -1,7 +1,6 @@
 //! Every injected fault kind is caught, with its violation kind and step.
 
-mod common;
-use common::*;
+use crate::common::*;
 use reconfcheck::certify::ViolationKind::*;
 use reconfcheck::lattice::Ground;
 use reconfcheck::lattice::{Cell, LatticeKind};

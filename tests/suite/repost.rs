@@ -9,7 +9,7 @@ use reconfcheck::certify::{Options, World, certify};
 use reconfcheck::lattice::Cell;
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 
 fn fill_name(fill: State) -> &'static str {
     if fill == State::Full {

@@ -1,5 +1,4 @@
 //! Shared builders for the integration tests.
-#![allow(dead_code)]
 
 use reconfcheck::certify::{self, Options, Report, ViolationKind};
 use reconfcheck::lattice::Ground;
