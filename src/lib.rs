@@ -2,7 +2,7 @@
 //! physically feasible.
 //!
 //! Layers, each depending only on those before it in this list (the test
-//! `tests/architecture.rs` enforces it):
+//! `tests/suite/architecture.rs` enforces it):
 //!
 //! 1. [`lattice`] — cells, neighbours, moves (FCC, square, cubic);
 //! 2. [`schedule`], [`scenario`] — the versioned schedule format shared by

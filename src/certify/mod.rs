@@ -171,9 +171,25 @@ pub fn checks_for(
     schedule: &Schedule,
     opts: &Options,
 ) -> Result<Vec<Box<dyn StepCheck>>, InputError> {
-    let mut checks: Vec<Box<dyn StepCheck>> = vec![Box::new(LatticeCheck)];
+    let mut checks = geometric_checks(schedule, opts);
     if opts.lattice_only {
         return Ok(checks);
+    }
+    if let Some(path) = model_path(schedule, opts) {
+        let model = crate::mechanics::Model::load(&path)?;
+        let check = LoadCheck::new(&model, schedule.spacing.metres(), true)
+            .map_err(|e| e.in_file(&path))?;
+        checks.push(Box::new(check));
+    }
+    Ok(checks)
+}
+
+/// The checks of `schedule` that need no physical model: the lattice's,
+/// and unless `opts` asks for the lattice only, the sweeps and dockings.
+fn geometric_checks(schedule: &Schedule, opts: &Options) -> Vec<Box<dyn StepCheck>> {
+    let mut checks: Vec<Box<dyn StepCheck>> = vec![Box::new(LatticeCheck)];
+    if opts.lattice_only {
+        return checks;
     }
     if let Some(model) = crate::geometry::sweep_model(schedule.lattice) {
         checks.push(Box::new(CollisionCheck {
@@ -192,13 +208,7 @@ pub fn checks_for(
             epsilon: opts.epsilon,
         }));
     }
-    if let Some(path) = model_path(schedule, opts) {
-        let model = crate::mechanics::Model::load(&path)?;
-        let check = LoadCheck::new(&model, schedule.spacing.metres(), true)
-            .map_err(|e| e.in_file(&path))?;
-        checks.push(Box::new(check));
-    }
-    Ok(checks)
+    checks
 }
 
 /// The model file the mechanics check uses: the user's, else the
@@ -241,6 +251,28 @@ pub fn certify_by(
         report.checks.push(MECHANICS_NOT_RUN.to_string());
     }
     Ok(report)
+}
+
+/// Certifies `schedule` with every check, the mechanics under `model` (a
+/// model in memory, e.g. with a study's pressure override) rather than a
+/// model file. Lattice-only options and atom schedules are certified as
+/// [`certify`] does, without `model`.
+pub fn certify_with_model(
+    schedule: &Schedule,
+    opts: &Options,
+    model: &crate::mechanics::Model,
+) -> Result<Report, InputError> {
+    if opts.lattice_only || schedule.atoms.is_some() || schedule.meta_modules.is_some() {
+        return certify(schedule, opts);
+    }
+    let mut checks = geometric_checks(schedule, opts);
+    checks.push(Box::new(LoadCheck::new(
+        model,
+        schedule.spacing.metres(),
+        true,
+    )?));
+    let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
+    certify_on(schedule, opts, &refs, &Threads)
 }
 
 /// Certifies `schedule` with the given checks. Input errors (not a schedule

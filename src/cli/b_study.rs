@@ -85,7 +85,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         .into_iter()
         .map(|i| lengths[i])
         .collect();
-    let part = b_study::study_rows(&m, &mine, generate, &progress);
+    let part = b_study::study_rows(&m, &mine, &generate, &progress);
     let (rows, unplanned, first_error) = match part {
         Ok((rows, unplanned, first)) => (Ok(rows), Ok(unplanned), first),
         Err(e) => (Err(e.clone()), Err(e), None),
@@ -113,7 +113,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = &a.html {
-        super::html::write_study(p, &st)?;
+        super::html::write_study(p, &st, &generate, &m, progress.clone())?;
     }
     if let Some(p) = &a.json {
         write_file(

@@ -3,6 +3,8 @@
 
 use reconfcheck::certify::{self, Options, Report};
 use reconfcheck::error::{Error, InputError, write_file};
+use reconfcheck::mechanics::Model;
+use reconfcheck::progress::Reporter;
 use reconfcheck::html::{self, Page};
 use reconfcheck::schedule::Schedule;
 use reconfcheck::study::b_study::Study;
@@ -67,19 +69,57 @@ pub fn write_report(
         schedule: Some(s),
         load_maps,
         study: None,
+        note: None,
     };
     write_file(path, page.html())?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
 
-/// Writes the page of a b-study: its curves and table.
-pub fn write_study(path: &Path, st: &Study) -> Result<(), Error> {
-    let page = Page {
+/// Writes the page of a b-study: its curves and table, and the replay of
+/// one b ([`Study::replayed_b`]: the smallest that breaks, else the
+/// largest), regenerated and certified again with every check under the
+/// study's model — one more b's work, for the picture of the failure.
+pub fn write_study(
+    path: &Path,
+    st: &Study,
+    generate: &dyn Fn(usize) -> Result<Schedule, InputError>,
+    model: &Model,
+    progress: Reporter,
+) -> Result<(), Error> {
+    let replayed = match st.replayed_b() {
+        Some((b, why)) => {
+            let s = generate(b)?;
+            let opts = Options {
+                name: format!("{} at b = {b}", st.family),
+                progress,
+                ..Options::default()
+            };
+            let m = model.at_spacing_checked(s.spacing.metres())?;
+            let report = certify::certify_with_model(&s, &opts, &m)?;
+            let steps = html::load_map_steps(&report, LOAD_MAPS);
+            let load_maps: Vec<html::LoadMap> = certify::load_maps_at(&s, &m, &steps)?
+                .into_iter()
+                .filter(|(_, st, _)| !st.links.is_empty())
+                .map(|(k, st, a)| html::load_map(k, &st, &a))
+                .collect();
+            Some((b, why, s, report, load_maps))
+        }
+        None => None,
+    };
+    let mut page = Page {
         title: format!("reconfcheck b-study: {}", st.family),
         study: Some(st),
         ..Default::default()
     };
+    if let Some((b, why, s, report, load_maps)) = &replayed {
+        page.note = Some(format!(
+            "The replay below is b = {b}, {why}: its schedule certified with every check."
+        ));
+        page.schedule = Some(s);
+        page.report = Some(report);
+        page.load_maps = load_maps.clone();
+    }
     write_file(path, page.html())?;
     eprintln!("wrote {}", path.display());
     Ok(())

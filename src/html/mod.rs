@@ -42,6 +42,8 @@ pub struct Page<'a> {
     /// Load maps of chosen steps (see [`load_map`]).
     pub load_maps: Vec<LoadMap>,
     pub study: Option<&'a Study>,
+    /// A line shown above everything else (e.g. which b a study replays).
+    pub note: Option<String>,
 }
 
 /// The connectors of one step with their utilisation.
@@ -110,6 +112,7 @@ pub struct PageData<'a> {
     pub replay: Option<Scene>,
     pub load_maps: &'a [LoadMap],
     pub study: Option<&'a Study>,
+    pub note: Option<&'a str>,
 }
 
 /// The report's header and verdict.
@@ -285,6 +288,7 @@ impl Page<'_> {
             replay: self.schedule.map(scene),
             load_maps: &self.load_maps,
             study: self.study,
+            note: self.note.as_deref(),
         }
     }
 

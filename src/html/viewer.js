@@ -76,10 +76,28 @@
     return out;
   }
 
-  // ---- Summary first --------------------------------------------------
+  // ---- b-study: its result is the page's summary, so it comes first ------
+  if (D.study) {
+    const st = D.study;
+    const s = section(`Branch-length study: ${st.family}`, 'study');
+    s.append(el('p', { class: 'verdict' }, `largest safe b: ${st.b_max}`));
+    s.append(el('p', {}, `model ${st.model}, pressure ${fmt(st.pressure_kpa)} kPa, bending ${st.bending}; closed form: b ≤ ${st.closed_b_max}`));
+    if (D.note) s.append(el('p', { id: 'note' }, D.note));
+    s.append(chart('max utilisation against b', 'b', [
+      { name: 'max utilisation', colour: '#d62728', marks: true, points: st.rows.map(r => [r.b, r.max_utilisation]) },
+      { name: 'closed form', colour: '#1f77b4', marks: true, points: st.rows.map(r => [r.b, r.closed_utilisation]) }], { hline: 1 }));
+    s.append(chart('minimum pressure (kPa) against b', 'b', [
+      { name: 'rigid hinge', colour: '#2ca02c', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_rigid_hinge]) },
+      { name: 'elastic', colour: '#9467bd', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_elastic]) }], { hline: st.pressure_kpa }));
+    s.append(table(['b', 'steps', 'lattice violations', 'max utilisation', 'critical step', 'critical connector', 'min pressure rigid (kPa)', 'min pressure elastic (kPa)'],
+      st.rows.map(r => [r.b, r.steps, r.lattice_violations, (r.max_utilisation_at_least ? '≥ ' : '') + fmt(r.max_utilisation), r.critical_step, r.critical_connector, fmt(r.min_pressure_rigid_hinge), fmt(r.min_pressure_elastic)])));
+    if (st.unplanned && st.unplanned.length) s.append(table(['b', 'not planned because'], st.unplanned.map(u => [u.b, u.reason])));
+  }
+
+  // ---- Summary (of the replayed b, on a study page) --------------------------------------------------
   const S = D.summary;
   if (S) {
-    const s = section('Summary', 'summary');
+    const s = section(D.study ? 'The replayed schedule' : 'Summary', 'summary');
     s.append(el('p', { class: S.certified ? 'verdict ok' : 'verdict bad' }, S.certified ? 'CERTIFIED' : 'NOT CERTIFIED'));
     s.append(table(['schedule', 'lattice', 'modules (start → end)', 'steps', 'moves', 'violations', 'warnings'],
       [[S.schedule, S.lattice, `${S.modules} → ${S.final_modules}`, S.steps, S.moves, D.violations.length < 5000 ? D.violations.length : '≥ 5000', D.warnings_total]]));
@@ -325,7 +343,7 @@
       for (let m = 0; m < N; m++) if (present[m]) { n++; h = (h * 31 + cell[3 * m] * 7 + cell[3 * m + 1] * 13 + cell[3 * m + 2] * 17 + m) | 0; }
       return `${n}:${(h >>> 0).toString(16)}`;
     }
-    return { goTo, state, digest, last };
+    return { goTo, state, digest, last, renderer };
   }
 
   // ---- Findings ------------------------------------------------------------
@@ -359,22 +377,6 @@
     D.metrics.forEach(([k, vals], i) => s.append(chart(k + ' per step', 'step', [{ name: k, colour: colours[i % colours.length], points: maxBins(vals, 1500) }], k.includes('utilisation') ? { hline: 1 } : undefined)));
   }
 
-  // ---- b-study -------------------------------------------------------------
-  if (D.study) {
-    const st = D.study;
-    const s = section(`Branch-length study: ${st.family}`, 'study');
-    s.append(el('p', {}, `model ${st.model}, pressure ${fmt(st.pressure_kpa)} kPa, bending ${st.bending}; largest safe b: ${st.b_max}`));
-    s.append(chart('max utilisation against b', 'b', [
-      { name: 'max utilisation', colour: '#d62728', marks: true, points: st.rows.map(r => [r.b, r.max_utilisation]) },
-      { name: 'closed form', colour: '#1f77b4', marks: true, points: st.rows.map(r => [r.b, r.closed_utilisation]) }], { hline: 1 }));
-    s.append(chart('minimum pressure (kPa) against b', 'b', [
-      { name: 'rigid hinge', colour: '#2ca02c', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_rigid_hinge]) },
-      { name: 'elastic', colour: '#9467bd', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_elastic]) }], { hline: st.pressure_kpa }));
-    s.append(table(['b', 'steps', 'lattice violations', 'max utilisation', 'critical step', 'critical connector', 'min pressure rigid (kPa)', 'min pressure elastic (kPa)'],
-      st.rows.map(r => [r.b, r.steps, r.lattice_violations, (r.max_utilisation_at_least ? '≥ ' : '') + fmt(r.max_utilisation), r.critical_step, r.critical_connector, fmt(r.min_pressure_rigid_hinge), fmt(r.min_pressure_elastic)])));
-    if (st.unplanned && st.unplanned.length) s.append(table(['b', 'not planned because'], st.unplanned.map(u => [u.b, u.reason])));
-  }
-
   app.append(el('footer', {}, `${D.generator}; three.js r160 (MIT) inlined; this page loads nothing from the network.`));
 
   // ---- Status for people and for tests/browser.rs --------------------------
@@ -383,13 +385,25 @@
     const parts = ['ready'];
     if (viewer) parts.push(`step=${viewer.state.step}`, `last=${viewer.last}`, `scene=${viewer.digest()}`, `highlighted=${viewer.state.highlighted}`, `markers=${viewer.state.markers}`, `loadmap=${viewer.state.loadmap}`);
     parts.push(`errors=${window.__errors.length}`, `ready_ms=${readyMs === null ? (performance.now() - t0).toFixed(0) : readyMs}`);
+    if (playMs !== null) parts.push(`play_ms_per_step=${playMs.toFixed(1)}`);
     if (window.__errors.length) parts.push('first_error=' + JSON.stringify(window.__errors[0]));
     statusEl.textContent = parts.join(' ');
   }
-  let readyMs = null;
+  let readyMs = null, playMs = null;
   if (D.replay && !window.THREE) console.error('three.js did not load');
   if (viewer) viewer.goTo(hash.has('step') ? +hash.get('step') : 0);
   readyMs = (performance.now()).toFixed(0);
   report();
+  // `#play=N`: step forward N times as the play button does, each step
+  // drawn and the GPU waited for, and report the mean time per step (how
+  // smoothly the page plays; read by the measurements in docs/report.md).
+  if (viewer && hash.has('play')) {
+    const n = Math.max(1, Math.min(+hash.get('play') || 1, viewer.last - viewer.state.step));
+    const t = performance.now();
+    for (let i = 0; i < n; i++) viewer.goTo(viewer.state.step + 1);
+    viewer.renderer.getContext().finish();
+    playMs = (performance.now() - t) / n;
+    report();
+  }
   window.addEventListener('hashchange', () => { const h = new URLSearchParams(location.hash.slice(1)); if (viewer && h.has('step')) viewer.goTo(+h.get('step')); });
 })();

@@ -397,6 +397,19 @@ pub fn assemble(
 }
 
 impl Study {
+    /// The branch length a study's page replays, and why: the smallest b
+    /// that does not hold (what the structure looks like when a connector
+    /// gives way), else the largest b studied. `None` for a study without
+    /// rows.
+    pub fn replayed_b(&self) -> Option<(usize, &'static str)> {
+        let mut rows: Vec<&Row> = self.rows.iter().collect();
+        rows.sort_by_key(|r| r.b);
+        if let Some(r) = rows.iter().find(|r| !r.safe()) {
+            return Some((r.b, "the smallest b that does not hold"));
+        }
+        rows.last().map(|r| (r.b, "the largest b studied; every b holds"))
+    }
+
     /// The study as text tables.
     pub fn table(&self) -> String {
         use std::fmt::Write as _;
@@ -545,6 +558,14 @@ mod tests {
         );
         // 100 kPa rigid hinge: b² ≤ pL³/(mgd) ≈ 46.6 → b = 6 grows, 7 fails.
         assert_eq!(st.b_max, 6);
+        // The page replays the failure, or the largest b where none fails.
+        assert_eq!(st.replayed_b(), Some((7, "the smallest b that does not hold")));
+        let holding = assemble("branch", &model, st.rows[..5].to_vec(), Vec::new());
+        assert_eq!(
+            holding.replayed_b(),
+            Some((5, "the largest b studied; every b holds"))
+        );
+        assert_eq!(assemble("branch", &model, Vec::new(), Vec::new()).replayed_b(), None);
         // The summary's closed form counts the same weights as the family's
         // worst step: it agrees with the data, row by row and in b_max.
         assert_eq!(st.closed_b_max, st.b_max);

@@ -1,6 +1,8 @@
 //! Seed 003 (active subtraction) end to end: the paper's figures, the
 //! guarantees of SAS and PAS, certification of every generated schedule.
 
+use crate::common;
+
 use reconfcheck::algorithms::active_subtraction::random::{Growth, random_shape};
 use reconfcheck::algorithms::active_subtraction::{Mode, Plan, Shape};
 use reconfcheck::algorithms::{self};
@@ -202,8 +204,7 @@ fn the_upright_humanoid_is_hollow_and_rejected_with_its_file_named() {
 
 #[test]
 fn invalid_desired_configurations_are_input_errors_naming_the_file() {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-as-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("as");
     let write = |name: &str, text: &str| {
         std::fs::write(dir.join(name), text).unwrap();
         dir.join(name)
@@ -420,7 +421,7 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
     #[cfg(feature = "render")]
     {
         let png =
-            std::env::temp_dir().join(format!("reconfcheck-density-{}.png", std::process::id()));
+            common::scratch("reconfcheck-density", "file.png");
         reconfcheck::render::density::plot(&cfg, &rows, &png).unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
@@ -542,7 +543,7 @@ fn density_study_spread_summarises_the_medians_of_repeated_studies() {
     #[cfg(feature = "render")]
     {
         let png =
-            std::env::temp_dir().join(format!("reconfcheck-spread-{}.png", std::process::id()));
+            common::scratch("reconfcheck-spread", "file.png");
         let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
         reconfcheck::render::density::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();
         assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");

@@ -127,7 +127,13 @@ fn colliding_page() -> PathBuf {
 
 /// The `#status` line of the page at `#step=K`, and the console output.
 fn status_at(browser: &Path, page: &Path, step: usize) -> (String, String) {
-    let url = format!("file://{}#step={step}", page.display());
+    status_with(browser, page, &format!("step={step}"))
+}
+
+/// The `#status` line of the page opened with the URL fragment `hash`
+/// (`step=K`, `play=N`), and the console output.
+fn status_with(browser: &Path, page: &Path, hash: &str) -> (String, String) {
+    let url = format!("file://{}#{hash}", page.display());
     let (dom, console) = run_chromium(browser, &url, &["--dump-dom".to_string()]);
     let start = dom
         .find("<div id=\"status\">")
@@ -189,6 +195,30 @@ fn a_violation_is_highlighted_at_its_step_and_not_before() {
     assert_eq!(field(&before, "highlighted"), "0");
     assert_eq!(field(&at, "highlighted"), "1", "{at}");
     assert_ne!(field(&at, "markers"), "0", "{at}");
+}
+
+#[test]
+fn the_b_study_page_replays_its_failing_b_and_plays_step_by_step() {
+    let browser = browser_or_skip!();
+    let page = tempdir("study").with_extension("html");
+    let o = common::bin()
+        .args(["b-study", "--family", "branch", "--b-min", "6", "--b-max", "7"])
+        .args(["--no-progress", "--html"])
+        .arg(&page)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let (status, console) = status_with(&browser, &page, "step=0&play=5");
+    assert!(status.starts_with("ready "), "{status}\n{console}");
+    assert_eq!(field(&status, "errors"), "0", "{status}");
+    assert!(console_errors(&console).is_empty(), "{console}");
+    // Five steps played from the start, each drawn, and timed.
+    assert_eq!(field(&status, "step"), "5", "{status}");
+    let ms: f64 = field(&status, "play_ms_per_step").parse().unwrap();
+    assert!(ms.is_finite() && ms >= 0.0, "{status}");
+    let (start, _) = status_at(&browser, &page, 0);
+    assert_ne!(field(&start, "scene"), field(&status, "scene"));
 }
 
 /// RGBA pixels of a PNG screenshot of the page at `#step=K`.

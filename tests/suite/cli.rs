@@ -1,18 +1,14 @@
 //! The command line: exit codes, bad input named by file, step and module,
 //! byte-identical reports.
 
+use crate::common::{self, bin};
+
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("cli", name)
 }
 
 fn write(name: &str, text: &str) -> PathBuf {
@@ -163,7 +159,7 @@ fn an_unknown_module_id_is_named_with_its_step() {
 
 #[test]
 fn a_cell_beyond_the_coordinate_range_is_unusable_input() {
-    // Found by tests/fuzz.rs: i32::MIN as a coordinate overflowed the
+    // Found by tests/suite/fuzz.rs: i32::MIN as a coordinate overflowed the
     // neighbour arithmetic.
     let mut s = walk();
     s["steps"][1]["events"][0]["to"] = json!([-2147483648i64, 0, 1]);

@@ -61,9 +61,14 @@ pub fn bin() -> std::process::Command {
 /// A path `name` in a scratch folder of this test process (`tag` keeps
 /// test files apart).
 pub fn scratch(tag: &str, name: &str) -> std::path::PathBuf {
+    scratch_dir(tag).join(name)
+}
+
+/// The scratch folder `tag` of this test process, created.
+pub fn scratch_dir(tag: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("reconfcheck-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    dir
 }
 
 /// The bundled walk's first step, written to `path`, plus a fixed module

@@ -3,6 +3,8 @@
 //! refused with exit 2, and the SLIDE moves the search derives certified in
 //! both atom models.
 
+use crate::common;
+
 use reconfcheck::algorithms::atom_moves::{derive_slide, describe};
 use reconfcheck::certify::{self, Options, Report, ViolationKind};
 use reconfcheck::geometry::atom_search::Carry;
@@ -10,7 +12,6 @@ use reconfcheck::lattice::AtomRest;
 use reconfcheck::schedule::Schedule;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn model() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("models/cube-atom.toml")
@@ -200,7 +201,7 @@ fn the_drive_load_matches_the_closed_form_and_overloads_a_weak_face() {
         );
     }
     // A face of 1 Pa cannot drag anything.
-    let weak = std::env::temp_dir().join(format!("cube-atom-weak-{}.toml", std::process::id()));
+    let weak = common::scratch("cube-atom-weak", "file.toml");
     std::fs::write(
         &weak,
         text.replace("pressure_kpa = 10.0", "pressure_kpa = 0.001"),
@@ -249,11 +250,10 @@ fn expanded_atoms_rest_three_units_apart_and_contract_together() {
 }
 
 fn cli_certify(name: &str, doc: &Value) -> (Option<i32>, String) {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-atoms-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("atoms");
     let p = dir.join(name);
     std::fs::write(&p, doc.to_string()).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+    let o = common::bin()
         .arg("certify")
         .arg(&p)
         .arg("--lattice-only")
@@ -389,8 +389,7 @@ fn a_comb_is_a_histogram_on_the_lowest_row() {
 
 #[test]
 fn robots_that_are_not_aligned_blocks_or_not_connected_are_refused_naming_file_and_reason() {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-comb-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("comb");
     let good = "##\n##\n";
     let cases = [
         ("shifted.txt", ".##\n.##\n", good, "aligned 2×2×2"),
@@ -418,7 +417,7 @@ fn robots_that_are_not_aligned_blocks_or_not_connected_are_refused_naming_file_a
             ),
         )
         .unwrap();
-        let o = Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+        let o = common::bin()
             .arg("generate")
             .arg(&scenario)
             .arg("-o")

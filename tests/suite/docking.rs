@@ -1,6 +1,8 @@
 //! Seed 002: the docking planner, its baselines, its certification by
 //! geometry, and Rule 1 against the geometry.
 
+use crate::common::{self, bin};
+
 use reconfcheck::algorithms::docking::goal::Goal;
 use reconfcheck::algorithms::docking::naive::{self, Order};
 use reconfcheck::algorithms::docking::planner::{self, Delays};
@@ -13,14 +15,9 @@ use reconfcheck::lattice::{Cell, Configuration, LatticeKind, SquareLattice};
 use reconfcheck::schedule::{Event, Length, ModuleSpec, Schedule, Step};
 use reconfcheck::study::docking::{SHAPES, goal};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn models() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("models/docking")
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
 }
 
 #[test]
@@ -177,8 +174,7 @@ fn a_docking_whose_approach_is_blocked_is_a_violation_naming_step_module_and_cel
 
 #[test]
 fn a_docking_with_no_legal_approach_fails_certify_with_exit_1() {
-    let dir = std::env::temp_dir().join(format!("docking-exit1-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("docking-exit1");
     // (0, 1) closed on all four sides: no approach at all.
     let s = docking_schedule(&[
         ((-1, 0), (0, -1), (0, 0)),
@@ -260,8 +256,7 @@ fn scenario(dir: &Path, name: &str, body: &str) -> PathBuf {
 
 #[test]
 fn bad_goals_are_refused_with_exit_2_naming_the_file() {
-    let dir = std::env::temp_dir().join(format!("docking-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("docking-bad");
     let cases = [
         (
             "two.csg",

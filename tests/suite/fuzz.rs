@@ -5,7 +5,7 @@
 //! collision sweeps and mechanics included. The same for the shape files:
 //! character-level edits of a CSG file and of a 2D grid file are refused or
 //! parsed; and for the scenarios: each generator's parameters, edited, are
-//! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test fuzz` searches longer.
+//! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test suite fuzz::` searches longer.
 
 use proptest::prelude::*;
 use reconfcheck::algorithms::random_walk::{WalkParams, walk};

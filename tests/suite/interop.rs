@@ -3,15 +3,17 @@
 //! certified move by move, and bad input refused with exit 2 naming the
 //! file, the line and the element.
 
+use crate::common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+    common::bin()
         .args(args)
         .current_dir(root())
         .output()
@@ -19,9 +21,7 @@ fn run(args: &[&str]) -> Output {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-interop-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("interop", name)
 }
 
 fn s(p: &Path) -> &str {

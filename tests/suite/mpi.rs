@@ -3,6 +3,8 @@
 //! `mpirun` on localhost). Without the feature, an MPI launch is refused
 //! with a clear message instead of every process doing all the work.
 
+use crate::common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -12,9 +14,7 @@ fn bin() -> &'static str {
 
 #[cfg_attr(not(feature = "mpi"), allow(dead_code))]
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reconfcheck-mpi-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("mpi", name)
 }
 
 #[cfg(feature = "mpi")]

@@ -116,3 +116,53 @@ fn b_study_writes_a_page_with_its_rows() {
     assert!(html.contains("\"family\":\"branch\""));
     assert!(html.contains("\"b\":2,") && html.contains("\"b\":3,"));
 }
+
+#[test]
+fn b_study_page_replays_the_smallest_b_that_breaks_with_its_overload() {
+    // The branch family under the default model holds up to b = 6 (the
+    // closed form's b² ≤ pL³/(mgd) ≈ 46.6); b = 7's last agent overloads
+    // the root connector.
+    let page = common::scratch("page", "study-replay.html");
+    let o = bin()
+        .args([
+            "b-study", "--family", "branch", "--b-min", "5", "--b-max", "7",
+        ])
+        .args(["--no-progress", "--html"])
+        .arg(&page)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let tag = "id=\"reconfcheck-data\">";
+    let start = html.find(tag).unwrap() + tag.len();
+    let end = start + html[start..].find("</script>").unwrap();
+    let data: serde_json::Value = serde_json::from_str(&html[start..end]).unwrap();
+    assert_eq!(data["study"]["b_max"], 6);
+    assert!(
+        data["note"]
+            .as_str()
+            .unwrap()
+            .starts_with("The replay below is b = 7, the smallest b that does not hold"),
+        "{}",
+        data["note"]
+    );
+    // The replayed schedule is b = 7's: 7 modules join the fixed base.
+    let summary = &data["summary"];
+    assert_eq!(summary["certified"], false);
+    assert_eq!(
+        summary["final_modules"].as_u64().unwrap() - summary["modules"].as_u64().unwrap(),
+        7
+    );
+    assert!(data["replay"].is_object());
+    let overloads: Vec<&serde_json::Value> = data["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|v| v["kind"] == "overload")
+        .collect();
+    assert!(!overloads.is_empty(), "{}", data["violations"]);
+    // The load map of the worst step is on the page and shows the overload.
+    let maps = data["load_maps"].as_array().unwrap();
+    assert!(maps.iter().any(|m| m["max_utilisation"].as_f64().unwrap() > 1.0));
+}

@@ -1,5 +1,7 @@
 //! Seed 000 scaffold schedules certify clean.
 
+use crate::common;
+
 use reconfcheck::algorithms::scaffold::{ShapeSpec, scaffold_schedule, scaffold_schedule_with};
 use reconfcheck::certify::{Options, certify};
 
@@ -154,8 +156,7 @@ fn every_module_enters_at_a_source_then_only_rotates() {
 
 #[test]
 fn shapes_outside_the_semi_convex_class_are_refused_with_the_reason() {
-    let dir = std::env::temp_dir().join(format!("scaffold-overhang-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("scaffold-overhang");
     let p = dir.join("mushroom.csg");
     // A thin stem under a wide cap: the cap's outer tiles have nothing under them.
     std::fs::write(
@@ -198,8 +199,7 @@ fn scaffolds_too_large_to_plan_are_refused_before_any_work() {
         8,
         "with b = 8 would have 3342650 modules; this build plans at most 1000000",
     );
-    let dir = std::env::temp_dir().join(format!("scaffold-huge-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("scaffold-huge");
     let p = dir.join("huge.csg");
     std::fs::write(&p, "b = 6;\ncube([1e12, 5, 5]);\n").unwrap();
     let e = scaffold_schedule(&ShapeSpec::Csg { path: p.clone() }, 6).unwrap_err();
@@ -220,14 +220,14 @@ fn placement_curve_counts_every_module_once() {
     assert_eq!(v.len(), s.steps.len());
     #[cfg(feature = "render")]
     {
-        let out = std::env::temp_dir().join(format!("scaffold-plot-{}.png", std::process::id()));
+        let out = common::scratch("scaffold-plot", "file.png");
         reconfcheck::render::placed_plot(&[("h2".into(), v)], "pyramid", &[], &out).unwrap();
         assert!(std::fs::metadata(&out).unwrap().len() > 1000);
     }
 }
 
 /// Reconfiguration time of h-pyramids against seed 000 Eq. (6) (a study:
-/// `cargo test --release --test scaffold pyramid_time_study -- --ignored --nocapture`).
+/// `cargo test --release --test suite scaffold::pyramid_time_study -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn pyramid_time_study() {
@@ -251,8 +251,8 @@ fn pyramid_time_study() {
 #[test]
 fn the_plot_command_writes_a_png_of_a_scenario() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = std::env::temp_dir().join(format!("scaffold-cli-plot-{}.png", std::process::id()));
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
+    let out = common::scratch("scaffold-cli-plot", "file.png");
+    let o = common::bin()
         .arg("plot")
         .arg(root.join("scenarios/pyramid-h3-b6.toml"))
         .arg("-o")
@@ -322,8 +322,8 @@ fn dense_b4_cubes_are_refused_up_front_naming_the_parameters() {
 
 /// Steps in both protocols and the moves of the paper's protocol that the
 /// exact catom body forbids (a study, release build:
-/// `SHAPES=pyramid2,pyramid3,cube-d5 cargo test --release --test scaffold
-/// protocol_study -- --ignored --nocapture`; shape names are `pyramidH`,
+/// `SHAPES=pyramid2,pyramid3,cube-d5 cargo test --release --test suite
+/// scaffold::protocol_study -- --ignored --nocapture`; shape names are `pyramidH`,
 /// or a file stem under models/shapes).
 #[test]
 #[ignore]
@@ -375,8 +375,7 @@ fn protocol_study() {
 
 #[test]
 fn an_unknown_protocol_is_refused_naming_the_scenario_and_the_parameter() {
-    let dir = std::env::temp_dir().join(format!("scaffold-protocol-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("scaffold-protocol");
     let p = dir.join("bad.toml");
     std::fs::write(
         &p,
@@ -401,8 +400,7 @@ fn an_unknown_protocol_is_refused_naming_the_scenario_and_the_parameter() {
 #[test]
 fn branches_cut_by_a_concavity_grow_partially_and_feed_no_tile() {
     use reconfcheck::algorithms::scaffold::build_scaffold;
-    let dir = std::env::temp_dir().join(format!("scaffold-plate-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch_dir("scaffold-plate");
     let p = dir.join("plate.csg");
     std::fs::write(
         &p,
