@@ -10,9 +10,6 @@ use reconfcheck::schedule::Schedule;
 use reconfcheck::study::b_study::Study;
 use std::path::Path;
 
-/// Load maps a page carries at most: each is one more structure analysed.
-const LOAD_MAPS: usize = 4;
-
 /// Refuses an `--html` path whose folder does not exist before any work is
 /// done: a certification of the sandcastle takes minutes, and its page
 /// should not be lost to a typo (exit 2, the flag's error).
@@ -40,8 +37,8 @@ pub fn check_path(path: &Path) -> Result<(), Error> {
 }
 
 /// Writes the page of a certification of `s` (read from `origin`): the
-/// replay, the report, and load maps of its worst steps where the
-/// mechanics ran.
+/// replay, the report, and where the mechanics ran the load maps
+/// ([`html::load_maps`]: every step where they fit).
 pub fn write_report(
     path: &Path,
     s: &Schedule,
@@ -54,14 +51,8 @@ pub fn write_report(
         && let Some(model_path) = certify::model_path(s, opts)
     {
         let model = reconfcheck::mechanics::Model::load(&model_path)?;
-        let steps = html::load_map_steps(report, LOAD_MAPS);
-        for (k, st, a) in certify::load_maps_at(s, &model, &steps).map_err(|e| e.in_file(origin))? {
-            // A step whose structure has no connector (all fixed, say)
-            // has nothing to colour.
-            if !st.links.is_empty() {
-                load_maps.push(html::load_map(k, &st, &a));
-            }
-        }
+        load_maps = html::load_maps(s, &model, report, html::LOAD_MAP_BUDGET)
+            .map_err(|e| e.in_file(origin))?;
     }
     let page = Page {
         title: format!("reconfcheck: {}", origin.display()),
@@ -97,12 +88,7 @@ pub fn write_study(
             };
             let m = model.at_spacing_checked(s.spacing.metres())?;
             let report = certify::certify_with_model(&s, &opts, &m)?;
-            let steps = html::load_map_steps(&report, LOAD_MAPS);
-            let load_maps: Vec<html::LoadMap> = certify::load_maps_at(&s, &m, &steps)?
-                .into_iter()
-                .filter(|(_, st, _)| !st.links.is_empty())
-                .map(|(k, st, a)| html::load_map(k, &st, &a))
-                .collect();
+            let load_maps = html::load_maps(&s, &m, &report, html::LOAD_MAP_BUDGET)?;
             Some((b, why, s, report, load_maps))
         }
         None => None,

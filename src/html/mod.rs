@@ -9,12 +9,11 @@
 //! first) and writes its state into `document.title` and the element
 //! `#status` once drawn, which the browser test reads.
 
+pub mod load_maps;
 pub mod replay;
 
 use crate::certify::{Report, Severity, Violation};
 use crate::lattice::{Cell, LatticeKind};
-use crate::mechanics::analysis::Analysis;
-use crate::mechanics::structure::Structure;
 use crate::schedule::Schedule;
 use crate::study::b_study::Study;
 use serde::Serialize;
@@ -46,55 +45,7 @@ pub struct Page<'a> {
     pub note: Option<String>,
 }
 
-/// The connectors of one step with their utilisation.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct LoadMap {
-    pub step: usize,
-    pub max_utilisation: f64,
-    /// `[x, y, z, nx, ny, nz, utilisation]` per connector: its contact
-    /// point and normal (units of d).
-    pub links: Vec<[f32; 7]>,
-}
-
-/// The load map of a structure and its analysis at `step`.
-pub fn load_map(step: usize, s: &Structure, a: &Analysis) -> LoadMap {
-    let links = s
-        .links
-        .iter()
-        .zip(&a.links)
-        .map(|(l, r)| {
-            let (c, n) = (l.contact.as_vec3(), l.normal.as_vec3());
-            [c.x, c.y, c.z, n.x, n.y, n.z, r.utilisation as f32]
-        })
-        .collect();
-    LoadMap {
-        step,
-        max_utilisation: a.max_utilisation,
-        links,
-    }
-}
-
-/// The steps worth a load map in `report`: the step of the highest
-/// utilisation and the first overloaded steps (at most `n` in all).
-pub fn load_map_steps(report: &Report, n: usize) -> Vec<usize> {
-    let mut steps = Vec::new();
-    let worst = report
-        .per_step
-        .iter()
-        .filter_map(|r| r.metrics.get("max_utilisation").map(|u| (*u, r.step)))
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    steps.extend(worst.map(|w| w.1));
-    for v in &report.violations {
-        if steps.len() >= n {
-            break;
-        }
-        if v.kind == crate::certify::ViolationKind::Overload && !steps.contains(&v.step) {
-            steps.push(v.step);
-        }
-    }
-    steps.sort_unstable();
-    steps
-}
+pub use load_maps::{LOAD_MAP_BUDGET, LoadMap, LoadMapData, load_map, load_maps};
 
 /// Everything the viewer reads, inlined as JSON.
 #[derive(Serialize)]
@@ -110,7 +61,10 @@ pub struct PageData<'a> {
     /// Per metric: its value at each step (`null` where not measured).
     pub metrics: Vec<(String, Vec<Option<f64>>)>,
     pub replay: Option<Scene>,
-    pub load_maps: &'a [LoadMap],
+    /// The load maps, packed (see [`LoadMapData`]); `load_maps_of` says
+    /// how many steps have one.
+    pub load_maps: Vec<LoadMapData>,
+    pub load_maps_of: usize,
     pub study: Option<&'a Study>,
     pub note: Option<&'a str>,
 }
@@ -286,7 +240,8 @@ impl Page<'_> {
             violation_counts,
             metrics,
             replay: self.schedule.map(scene),
-            load_maps: &self.load_maps,
+            load_maps: self.load_maps.iter().map(LoadMapData::of).collect(),
+            load_maps_of: self.schedule.map_or(0, |s| s.steps.len() + 1),
             study: self.study,
             note: self.note.as_deref(),
         }

@@ -182,3 +182,83 @@ fn a_load_map_colours_every_connector_by_its_utilisation() {
     let top = m.links.iter().map(|l| l[6]).fold(0f32, f32::max);
     assert!((top as f64 - a.max_utilisation).abs() < 1e-5 * a.max_utilisation.max(1.0));
 }
+
+#[test]
+fn every_step_has_a_load_map_when_they_fit_and_the_budget_holds_when_not() {
+    let s = scaffold();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let model = crate::mechanics::Model::load(&path).unwrap();
+    let opts = Options {
+        model: Some(path),
+        ..Options::default()
+    };
+    let report = certify::certify(&s, &opts).unwrap();
+    let last = s.steps.len() + 1;
+    let all = load_maps(&s, &model, &report, usize::MAX).unwrap();
+    // Every step whose structure has a connector, the final one included,
+    // each with the connectors of that step analysed alone.
+    let every: Vec<_> = certify::load_maps_at(&s, &model, &(1..=last).collect::<Vec<_>>())
+        .unwrap()
+        .into_iter()
+        .filter(|(_, st, _)| !st.links.is_empty())
+        .collect();
+    assert!(every.len() > 20);
+    assert_eq!(
+        all.iter().map(|m| m.step).collect::<Vec<_>>(),
+        every.iter().map(|m| m.0).collect::<Vec<_>>()
+    );
+    for (m, (k, st, a)) in all.iter().zip(&every) {
+        let alone = load_map(*k, st, a);
+        assert_eq!(m.links.len(), alone.links.len(), "step {k}");
+        for (x, y) in m.links.iter().zip(&alone.links) {
+            assert!((x[6] - y[6]).abs() <= 1e-6 * y[6].max(1.0), "step {k}");
+        }
+    }
+    let worst = report
+        .per_step
+        .iter()
+        .filter_map(|r| r.metrics.get("max_utilisation").map(|u| (*u, r.step)))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap()
+        .1;
+    assert_eq!(
+        all.iter().find(|m| m.why == load_maps::Why::Worst).map(|m| m.step),
+        Some(worst)
+    );
+    assert_eq!(all.last().unwrap().step, last);
+    // A budget with room for three more maps beyond the ones that always
+    // come: those, and at most three spread steps, within the budget.
+    let firsts: usize = all
+        .iter()
+        .filter(|m| m.why != load_maps::Why::Spread)
+        .map(|m| m.links.len())
+        .sum();
+    let largest = all.iter().map(|m| m.links.len()).max().unwrap();
+    let budget = firsts + 3 * largest;
+    let some = load_maps(&s, &model, &report, budget).unwrap();
+    let total: usize = some.iter().map(|m| m.links.len()).sum();
+    assert!(total <= budget, "{total} > {budget}");
+    let spread = some
+        .iter()
+        .filter(|m| m.why == load_maps::Why::Spread)
+        .count();
+    assert!((1..=3).contains(&spread), "{spread}");
+    assert!(some.iter().any(|m| m.why == load_maps::Why::Worst));
+    // Packed on the page, one entry per map with its connector count.
+    let page = Page {
+        title: "t".into(),
+        report: Some(&report),
+        schedule: Some(&s),
+        load_maps: some.clone(),
+        ..Default::default()
+    };
+    let data = inlined(&page.html());
+    let maps = data["load_maps"].as_array().unwrap();
+    assert_eq!(maps.len(), some.len());
+    assert_eq!(data["load_maps_of"], last);
+    for (d, m) in maps.iter().zip(&some) {
+        assert_eq!(d["connectors"], m.links.len());
+        let back = load_maps::unpack(&replay::unbase64(d["links"].as_str().unwrap()));
+        assert_eq!(back.len(), m.links.len());
+    }
+}

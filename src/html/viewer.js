@@ -138,9 +138,21 @@
     const speed = el('input', { type: 'number', min: 1, max: 200, value: steps > 500 ? 30 : 4, id: 'speed', title: 'steps per second' });
     const loadBox = el('input', { type: 'checkbox', id: 'loadmap', checked: '' });
     const loadSteps = new Map(D.load_maps.map(m => [m.step, m]));
+    // A load map's connectors, unpacked on first use (see LoadMapData):
+    // [x, y, z, nx, ny, nz, utilisation] each.
+    function loadLinks(m) {
+      if (m.unpacked) return m.unpacked;
+      const w = ints(m.links), out = new Array(m.connectors);
+      for (let j = 0; j < m.connectors; j++) {
+        const a = w[3 * j], b = w[3 * j + 1], c = w[3 * j + 2];
+        out[j] = [((a << 16) >> 16) / 32, (a >> 16) / 32, ((b << 16) >> 16) / 32,
+          ((b << 8) >> 24) / 127, (b >> 24) / 127, ((c << 24) >> 24) / 127, ((c >>> 8) & 0xffffff) / 1048576];
+      }
+      return (m.unpacked = out);
+    }
     const jumpSel = el('select', { id: 'jump' }, el('option', { value: '' }, 'go to…'),
       ...[...new Set(D.violations.map(v => v.step))].slice(0, 500).map(k => el('option', { value: k }, `violation at step ${k}`)),
-      ...D.load_maps.map(m => el('option', { value: m.step }, `load map at step ${m.step}`)));
+      ...D.load_maps.filter(m => m.why !== 'spread').map(m => el('option', { value: m.step }, `load map at step ${m.step} (${m.why})`)));
     const legend = el('div', { class: 'legend' },
       ...[['fixed', '#8a8f98'], ['static', '#4a90d9'], ['moving', '#f5a623'], ['entering', '#2ecc71'], ['violation bodies', '#e0002a'], ['blocking cells, witness', '#ff00ff']]
         .map(([n, c]) => el('span', {}, el('i', { style: `background:${c}` }), n)));
@@ -297,10 +309,10 @@
       material.opacity = showLoad ? 0.18 : 1;
       material.depthWrite = !showLoad;
       if (showLoad) {
-        const n = lm.links.length;
+        const links = loadLinks(lm), n = links.length;
         const plates = new THREE.InstancedMesh(new THREE.BoxGeometry(0.3, 0.3, 0.05), new THREE.MeshBasicMaterial(), Math.max(1, n));
         const q = new THREE.Quaternion(), z = new THREE.Vector3(0, 0, 1), one = new THREE.Vector3(1, 1, 1);
-        lm.links.forEach((l, j) => {
+        links.forEach((l, j) => {
           q.setFromUnitVectors(z, new THREE.Vector3(l[3], l[4], l[5]).normalize());
           plates.setMatrixAt(j, new THREE.Matrix4().compose(new THREE.Vector3(l[0], l[1], l[2]), q, one));
           plates.setColorAt(j, utilColour(l[6]));
@@ -312,10 +324,11 @@
       slider.value = k;
       label.textContent = k === 0 ? `initial (0 / ${steps})` : k === last ? `final (${steps} / ${steps})` : `step ${k} / ${steps}`;
       info.replaceChildren(...[el('h3', {}, label.textContent),
-        showLoad ? el('p', {}, `load map: max utilisation ${fmt(lm.max_utilisation)} over ${lm.links.length} connectors`) : null,
+        showLoad ? el('p', {}, `load map: max utilisation ${fmt(lm.max_utilisation)} over ${lm.connectors} connectors`)
+          : D.load_maps.length && !lm ? el('p', { class: 'hint' }, `no load map at this step: ${D.load_maps.length} of ${D.load_maps_of} steps have one (the page's size budget)`) : null,
         found.length ? el('ul', {}, ...found.slice(0, 50).map(v => el('li', { class: v.severity }, `${v.severity} ${v.kind}: ${v.message}`))) : el('p', {}, 'no findings at this step'),
         found.length > 50 ? el('p', {}, `… ${found.length - 50} more`) : null].filter(x => x));
-      state.step = k; state.highlighted = highlighted; state.markers = markers.children.length; state.loadmap = showLoad ? lm.links.length : 0;
+      state.step = k; state.highlighted = highlighted; state.markers = markers.children.length; state.loadmap = showLoad ? lm.connectors : 0;
       draw();
       report();
     }

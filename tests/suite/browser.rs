@@ -219,6 +219,10 @@ fn the_b_study_page_replays_its_failing_b_and_plays_step_by_step() {
     assert!(ms.is_finite() && ms >= 0.0, "{status}");
     let (start, _) = status_at(&browser, &page, 0);
     assert_ne!(field(&start, "scene"), field(&status, "scene"));
+    // Every step of so small a run has its load map: step 5 draws its
+    // connectors.
+    let connectors: usize = field(&status, "loadmap").parse().unwrap();
+    assert!(connectors > 0, "{status}");
 }
 
 /// RGBA pixels of a PNG screenshot of the page at `#step=K`.
