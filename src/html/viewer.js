@@ -87,10 +87,10 @@
       { name: 'max utilisation', colour: '#d62728', marks: true, points: st.rows.map(r => [r.b, r.max_utilisation]) },
       { name: 'closed form', colour: '#1f77b4', marks: true, points: st.rows.map(r => [r.b, r.closed_utilisation]) }], { hline: 1 }));
     s.append(chart('minimum pressure (kPa) against b', 'b', [
-      { name: 'rigid hinge', colour: '#2ca02c', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_rigid_hinge]) },
-      { name: 'elastic', colour: '#9467bd', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_elastic]) }], { hline: st.pressure_kpa }));
+      { name: 'rigid hinge', colour: '#2ca02c', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_rigid_hinge / 1e3]) },
+      { name: 'elastic', colour: '#9467bd', marks: true, points: st.rows.map(r => [r.b, r.min_pressure_elastic / 1e3]) }], { hline: st.pressure_kpa }));
     s.append(table(['b', 'steps', 'lattice violations', 'max utilisation', 'critical step', 'critical connector', 'min pressure rigid (kPa)', 'min pressure elastic (kPa)'],
-      st.rows.map(r => [r.b, r.steps, r.lattice_violations, (r.max_utilisation_at_least ? '≥ ' : '') + fmt(r.max_utilisation), r.critical_step, r.critical_connector, fmt(r.min_pressure_rigid_hinge), fmt(r.min_pressure_elastic)])));
+      st.rows.map(r => [r.b, r.steps, r.lattice_violations, (r.max_utilisation_at_least ? '≥ ' : '') + fmt(r.max_utilisation), r.critical_step, r.critical_connector, fmt(r.min_pressure_rigid_hinge / 1e3), fmt(r.min_pressure_elastic / 1e3)])));
     if (st.unplanned && st.unplanned.length) s.append(table(['b', 'not planned because'], st.unplanned.map(u => [u.b, u.reason])));
   }
 
@@ -199,6 +199,21 @@
     const grow = p => { for (let a = 0; a < 3; a++) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); } };
     for (let i = 0; i < initial.length; i += 3) grow(centre(initial[i], initial[i + 1], initial[i + 2]));
     for (let i = 0; i < enters.length; i += 4) grow(centre(enters[i + 1], enters[i + 2], enters[i + 3]));
+    // Every cell a module reaches, so that a run which grows by moves (a
+    // branch from one entry cell) is framed whole: one pass over the moves.
+    {
+      const c = cell.slice();
+      for (let i = 0; i < jumps.length; i += 7) grow(centre(jumps[i + 4], jumps[i + 5], jumps[i + 6]));
+      for (let k = 0; k < steps; k++) { // in the order apply() takes them
+        for (let r = ms[k]; r < ms[k + 1]; r++) {
+          const m = moves[2 * r], p = moves[2 * r + 1];
+          c[3 * m] += (p & 1023) - 512; c[3 * m + 1] += ((p >> 10) & 1023) - 512; c[3 * m + 2] += ((p >> 20) & 1023) - 512;
+          grow(centre(c[3 * m], c[3 * m + 1], c[3 * m + 2]));
+        }
+        for (let r = js[k]; r < js[k + 1]; r++) c.set(jumps.subarray(7 * r + 4, 7 * r + 7), 3 * jumps[7 * r]);
+        for (let r = es[k]; r < es[k + 1]; r++) c.set(enters.subarray(4 * r + 1, 4 * r + 4), 3 * enters[4 * r]);
+      }
+    }
     if (!isFinite(lo[0])) { lo.fill(-1); hi.fill(1); }
     const mid = lo.map((v, a) => (v + hi[a]) / 2), span = Math.max(2, ...hi.map((v, a) => v - lo[a]));
     if (R.ground !== null && R.ground !== undefined) {
