@@ -3,9 +3,9 @@
 
 use reconfcheck::certify::{self, Options, Report};
 use reconfcheck::error::{Error, InputError, write_file};
+use reconfcheck::html::{self, Page};
 use reconfcheck::mechanics::Model;
 use reconfcheck::progress::Reporter;
-use reconfcheck::html::{self, Page};
 use reconfcheck::schedule::Schedule;
 use reconfcheck::study::b_study::Study;
 use std::path::Path;

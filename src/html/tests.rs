@@ -222,7 +222,9 @@ fn every_step_has_a_load_map_when_they_fit_and_the_budget_holds_when_not() {
         .unwrap()
         .1;
     assert_eq!(
-        all.iter().find(|m| m.why == load_maps::Why::Worst).map(|m| m.step),
+        all.iter()
+            .find(|m| m.why == load_maps::Why::Worst)
+            .map(|m| m.step),
         Some(worst)
     );
     assert_eq!(all.last().unwrap().step, last);

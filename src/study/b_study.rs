@@ -407,7 +407,8 @@ impl Study {
         if let Some(r) = rows.iter().find(|r| !r.safe()) {
             return Some((r.b, "the smallest b that does not hold"));
         }
-        rows.last().map(|r| (r.b, "the largest b studied; every b holds"))
+        rows.last()
+            .map(|r| (r.b, "the largest b studied; every b holds"))
     }
 
     /// The study as text tables.
@@ -559,13 +560,19 @@ mod tests {
         // 100 kPa rigid hinge: b² ≤ pL³/(mgd) ≈ 46.6 → b = 6 grows, 7 fails.
         assert_eq!(st.b_max, 6);
         // The page replays the failure, or the largest b where none fails.
-        assert_eq!(st.replayed_b(), Some((7, "the smallest b that does not hold")));
+        assert_eq!(
+            st.replayed_b(),
+            Some((7, "the smallest b that does not hold"))
+        );
         let holding = assemble("branch", &model, st.rows[..5].to_vec(), Vec::new());
         assert_eq!(
             holding.replayed_b(),
             Some((5, "the largest b studied; every b holds"))
         );
-        assert_eq!(assemble("branch", &model, Vec::new(), Vec::new()).replayed_b(), None);
+        assert_eq!(
+            assemble("branch", &model, Vec::new(), Vec::new()).replayed_b(),
+            None
+        );
         // The summary's closed form counts the same weights as the family's
         // worst step: it agrees with the data, row by row and in b_max.
         assert_eq!(st.closed_b_max, st.b_max);

@@ -420,8 +420,7 @@ fn density_study_pas_beats_sas_and_sas_grows_with_size() {
     }
     #[cfg(feature = "render")]
     {
-        let png =
-            common::scratch("reconfcheck-density", "file.png");
+        let png = common::scratch("reconfcheck-density", "file.png");
         reconfcheck::render::density::plot(&cfg, &rows, &png).unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
@@ -542,8 +541,7 @@ fn density_study_spread_summarises_the_medians_of_repeated_studies() {
     );
     #[cfg(feature = "render")]
     {
-        let png =
-            common::scratch("reconfcheck-spread", "file.png");
+        let png = common::scratch("reconfcheck-spread", "file.png");
         let rows = study::summarise(&cfg, &study::run(&cfg).unwrap());
         reconfcheck::render::density::plot_with_spread(&cfg, &rows, &spread, &png).unwrap();
         assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");

@@ -202,7 +202,9 @@ fn the_b_study_page_replays_its_failing_b_and_plays_step_by_step() {
     let browser = browser_or_skip!();
     let page = tempdir("study").with_extension("html");
     let o = common::bin()
-        .args(["b-study", "--family", "branch", "--b-min", "6", "--b-max", "7"])
+        .args([
+            "b-study", "--family", "branch", "--b-min", "6", "--b-max", "7",
+        ])
         .args(["--no-progress", "--html"])
         .arg(&page)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -226,8 +228,15 @@ fn the_b_study_page_replays_its_failing_b_and_plays_step_by_step() {
     // The study's table and curves are in kPa, as their headings say: b = 7
     // needs 106.2 kPa under the rigid hinge (its utilisation 1.062 at the
     // model's 100 kPa).
-    let (dom, _) = run_chromium(&browser, &format!("file://{}", page.display()), &["--dump-dom".to_string()]);
-    assert!(dom.contains("<td>106.2"), "no 106.2 kPa cell in the study's table");
+    let (dom, _) = run_chromium(
+        &browser,
+        &format!("file://{}", page.display()),
+        &["--dump-dom".to_string()],
+    );
+    assert!(
+        dom.contains("<td>106.2"),
+        "no 106.2 kPa cell in the study's table"
+    );
 }
 
 /// RGBA pixels of a PNG screenshot of the page at `#step=K`.

@@ -164,5 +164,8 @@ fn b_study_page_replays_the_smallest_b_that_breaks_with_its_overload() {
     assert!(!overloads.is_empty(), "{}", data["violations"]);
     // The load map of the worst step is on the page and shows the overload.
     let maps = data["load_maps"].as_array().unwrap();
-    assert!(maps.iter().any(|m| m["max_utilisation"].as_f64().unwrap() > 1.0));
+    assert!(
+        maps.iter()
+            .any(|m| m["max_utilisation"].as_f64().unwrap() > 1.0)
+    );
 }
