@@ -247,6 +247,15 @@
     // Markers of the findings and the load map, rebuilt per step.
     const markers = new THREE.Group();
     scene.add(markers);
+    // The load map's plates: one instanced mesh for every step, sized for
+    // the largest map, so that playing allocates nothing per step.
+    const plates = new THREE.InstancedMesh(new THREE.BoxGeometry(0.3, 0.3, 0.05), new THREE.MeshBasicMaterial(),
+      Math.max(1, D.load_maps.reduce((n, m) => Math.max(n, m.connectors), 0)));
+    plates.count = 0;
+    plates.frustumCulled = false;
+    plates.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+    scene.add(plates);
+    const plateQ = new THREE.Quaternion(), plateZ = new THREE.Vector3(0, 0, 1), plateN = new THREE.Vector3(), plateP = new THREE.Vector3(), plateOne = new THREE.Vector3(1, 1, 1), plateM = new THREE.Matrix4();
     // Transparent (at full opacity) so that they are drawn in the same pass
     // as the bodies, after them (renderOrder), and without a depth test:
     // always in view.
@@ -307,6 +316,7 @@
         for (let r = js[i]; r < js[i + 1]; r++) tint(jumps[7 * r], COL.moving);
         for (let r = es[i]; r < es[i + 1]; r++) tint(enters[4 * r], COL.entering);
       }
+      for (const c of markers.children) if (c.geometry !== cellGeo && c.geometry !== witnessGeo) c.geometry.dispose();
       markers.clear();
       const found = byStep.get(k) || [];
       let highlighted = 0;
@@ -323,16 +333,17 @@
       const showLoad = lm && loadBox.checked;
       material.opacity = showLoad ? 0.18 : 1;
       material.depthWrite = !showLoad;
+      plates.count = 0;
       if (showLoad) {
-        const links = loadLinks(lm), n = links.length;
-        const plates = new THREE.InstancedMesh(new THREE.BoxGeometry(0.3, 0.3, 0.05), new THREE.MeshBasicMaterial(), Math.max(1, n));
-        const q = new THREE.Quaternion(), z = new THREE.Vector3(0, 0, 1), one = new THREE.Vector3(1, 1, 1);
+        const links = loadLinks(lm);
         links.forEach((l, j) => {
-          q.setFromUnitVectors(z, new THREE.Vector3(l[3], l[4], l[5]).normalize());
-          plates.setMatrixAt(j, new THREE.Matrix4().compose(new THREE.Vector3(l[0], l[1], l[2]), q, one));
+          plateQ.setFromUnitVectors(plateZ, plateN.set(l[3], l[4], l[5]).normalize());
+          plates.setMatrixAt(j, plateM.compose(plateP.set(l[0], l[1], l[2]), plateQ, plateOne));
           plates.setColorAt(j, utilColour(l[6]));
         });
-        markers.add(plates);
+        plates.count = links.length;
+        plates.instanceMatrix.needsUpdate = true;
+        if (plates.instanceColor) plates.instanceColor.needsUpdate = true;
       }
       mesh.instanceMatrix.needsUpdate = true;
       if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
