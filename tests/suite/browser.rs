@@ -201,16 +201,7 @@ fn a_violation_is_highlighted_at_its_step_and_not_before() {
 fn the_b_study_page_replays_its_failing_b_and_plays_step_by_step() {
     let browser = browser_or_skip!();
     let page = tempdir("study").with_extension("html");
-    let o = common::bin()
-        .args([
-            "b-study", "--family", "branch", "--b-min", "6", "--b-max", "7",
-        ])
-        .args(["--no-progress", "--html"])
-        .arg(&page)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    common::branch_study_page(&page, 6, 7);
     let (status, console) = status_with(&browser, &page, "step=0&play=5");
     assert!(status.starts_with("ready "), "{status}\n{console}");
     assert_eq!(field(&status, "errors"), "0", "{status}");

@@ -89,3 +89,19 @@ pub fn walk_with_obstacle(path: &std::path::Path, obstacle: bool) {
         .push(serde_json::json!({"id": 900, "cell": cell, "fixed": true}));
     std::fs::write(path, s.to_string()).unwrap();
 }
+
+/// The page of `b-study --family branch --b-min LO --b-max HI --html`,
+/// written to `page` (the run must succeed).
+pub fn branch_study_page(page: &std::path::Path, lo: usize, hi: usize) {
+    let o = bin()
+        .args(["b-study", "--family", "branch", "--b-min"])
+        .arg(lo.to_string())
+        .arg("--b-max")
+        .arg(hi.to_string())
+        .args(["--no-progress", "--html"])
+        .arg(page)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+}

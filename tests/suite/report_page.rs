@@ -102,16 +102,7 @@ fn the_summary_says_what_a_lattice_only_run_did_not_check() {
 #[test]
 fn b_study_writes_a_page_with_its_rows() {
     let page = common::scratch("page", "study.html");
-    let o = bin()
-        .args([
-            "b-study", "--family", "branch", "--b-min", "2", "--b-max", "3",
-        ])
-        .args(["--no-progress", "--html"])
-        .arg(&page)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    common::branch_study_page(&page, 2, 3);
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(html.contains("\"family\":\"branch\""));
     assert!(html.contains("\"b\":2,") && html.contains("\"b\":3,"));
@@ -123,16 +114,7 @@ fn b_study_page_replays_the_smallest_b_that_breaks_with_its_overload() {
     // closed form's b² ≤ pL³/(mgd) ≈ 46.6); b = 7's last agent overloads
     // the root connector.
     let page = common::scratch("page", "study-replay.html");
-    let o = bin()
-        .args([
-            "b-study", "--family", "branch", "--b-min", "5", "--b-max", "7",
-        ])
-        .args(["--no-progress", "--html"])
-        .arg(&page)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    common::branch_study_page(&page, 5, 7);
     let html = std::fs::read_to_string(&page).unwrap();
     let tag = "id=\"reconfcheck-data\">";
     let start = html.find(tag).unwrap() + tag.len();
