@@ -78,34 +78,33 @@ pub fn write_study(
     model: &Model,
     progress: Reporter,
 ) -> Result<(), Error> {
-    let replayed = match st.replayed_b() {
-        Some((b, why)) => {
-            let s = generate(b)?;
-            let opts = Options {
-                name: format!("{} at b = {b}", st.family),
-                progress,
-                ..Options::default()
-            };
-            let m = model.at_spacing_checked(s.spacing.metres())?;
-            let report = certify::certify_with_model(&s, &opts, &m)?;
-            let load_maps = html::load_maps(&s, &m, &report, html::LOAD_MAP_BUDGET)?;
-            Some((b, why, s, report, load_maps))
-        }
-        None => None,
-    };
-    let mut page = Page {
-        title: format!("reconfcheck b-study: {}", st.family),
-        study: Some(st),
-        ..Default::default()
-    };
-    if let Some((b, why, s, report, load_maps)) = &replayed {
-        page.note = Some(format!(
+    // The replayed b: its schedule, report and load maps (the mechanics
+    // rescale `model` to the schedule's spacing themselves).
+    let mut replayed = None;
+    let mut load_maps = Vec::new();
+    let mut note = None;
+    if let Some((b, why)) = st.replayed_b() {
+        let s = generate(b)?;
+        let opts = Options {
+            name: format!("{} at b = {b}", st.family),
+            progress,
+            ..Options::default()
+        };
+        let report = certify::certify_with_model(&s, &opts, model)?;
+        load_maps = html::load_maps(&s, model, &report, html::LOAD_MAP_BUDGET)?;
+        note = Some(format!(
             "The replay below is b = {b}, {why}: its schedule certified with every check."
         ));
-        page.schedule = Some(s);
-        page.report = Some(report);
-        page.load_maps = load_maps.clone();
+        replayed = Some((s, report));
     }
+    let page = Page {
+        title: format!("reconfcheck b-study: {}", st.family),
+        report: replayed.as_ref().map(|r| &r.1),
+        schedule: replayed.as_ref().map(|r| &r.0),
+        load_maps,
+        study: Some(st),
+        note,
+    };
     write_file(path, page.html())?;
     eprintln!("wrote {}", path.display());
     Ok(())

@@ -200,20 +200,14 @@
     for (let i = 0; i < initial.length; i += 3) grow(centre(initial[i], initial[i + 1], initial[i + 2]));
     for (let i = 0; i < enters.length; i += 4) grow(centre(enters[i + 1], enters[i + 2], enters[i + 3]));
     // Every cell a module reaches, so that a run which grows by moves (a
-    // branch from one entry cell) is framed whole: one pass over the moves.
-    {
-      const c = cell.slice();
-      for (let i = 0; i < jumps.length; i += 7) grow(centre(jumps[i + 4], jumps[i + 5], jumps[i + 6]));
-      for (let k = 0; k < steps; k++) { // in the order apply() takes them
-        for (let r = ms[k]; r < ms[k + 1]; r++) {
-          const m = moves[2 * r], p = moves[2 * r + 1];
-          c[3 * m] += (p & 1023) - 512; c[3 * m + 1] += ((p >> 10) & 1023) - 512; c[3 * m + 2] += ((p >> 20) & 1023) - 512;
-          grow(centre(c[3 * m], c[3 * m + 1], c[3 * m + 2]));
-        }
-        for (let r = js[k]; r < js[k + 1]; r++) c.set(jumps.subarray(7 * r + 4, 7 * r + 7), 3 * jumps[7 * r]);
-        for (let r = es[k]; r < es[k + 1]; r++) c.set(enters.subarray(4 * r + 1, 4 * r + 4), 3 * enters[4 * r]);
-      }
+    // branch from one entry cell) is framed whole: the replay played to
+    // the end and back (apply() is exact), growing by each step's movers.
+    for (let i = 0; i < jumps.length; i += 7) grow(centre(jumps[i + 4], jumps[i + 5], jumps[i + 6]));
+    for (let k = 1; k <= steps; k++) {
+      apply(k, 1);
+      for (let r = ms[k - 1]; r < ms[k]; r++) { const m = moves[2 * r]; grow(centre(cell[3 * m], cell[3 * m + 1], cell[3 * m + 2])); }
     }
+    for (let k = steps; k >= 1; k--) apply(k, -1);
     if (!isFinite(lo[0])) { lo.fill(-1); hi.fill(1); }
     const mid = lo.map((v, a) => (v + hi[a]) / 2), span = Math.max(2, ...hi.map((v, a) => v - lo[a]));
     if (R.ground !== null && R.ground !== undefined) {
