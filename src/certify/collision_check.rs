@@ -1,9 +1,10 @@
 //! True collision check (SPEC §4.3): each step's sweeps, through the
-//! lattice's [`SweepModel`].
+//! lattice's [`SweepModel`], against the other modules and, where the
+//! scene has a ground, against the floor under it.
 
 use super::report::{Severity, Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
-use crate::geometry::{Contact, ContactKind, SweepInput, SweepModel};
+use crate::geometry::{Contact, ContactKind, GroundContact, SweepInput, SweepModel};
 use crate::lattice::Motion;
 
 /// Runs a sweep model on every step.
@@ -38,6 +39,12 @@ impl StepCheck for CollisionCheck {
             match c.kind {
                 ContactKind::Collision => out.violations.push(v),
                 ContactKind::SlidingContact => out.warnings.push(v.severity(Severity::Warning)),
+            }
+        }
+        if let Some(ground) = ctx.world.ground() {
+            for c in self.model.check_ground(&input, ground) {
+                deepest = deepest.max(c.depth);
+                out.violations.push(ground_violation(&c, ctx));
             }
         }
         if deepest > 0.0 {
@@ -85,6 +92,37 @@ fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
         Some(Motion::Slide {
             pivot: Some(pivot), ..
         }) => v.detail("pivot_cell", pivot),
+        _ => v,
+    }
+}
+
+/// The violation of a mover digging into the floor: its link's cells and
+/// its pivot's cell, the floor's height and the deepest point.
+fn ground_violation(c: &GroundContact, ctx: &StepContext<'_>) -> Violation {
+    let motion = ctx
+        .plan
+        .moves
+        .iter()
+        .find(|m| m.module == c.mover)
+        .map(|m| &m.motion);
+    let v = Violation::new(
+        ViolationKind::GroundCollision,
+        ctx.plan.step,
+        format!(
+            "module {} dips {:.3e} d below the floor (z = {:.4} d) at s = {:.4}",
+            c.mover, c.depth, c.floor, c.s
+        ),
+    )
+    .modules([c.mover])
+    .cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten())
+    .detail("s", c.s)
+    .detail("depth", c.depth)
+    .detail("floor_z", c.floor)
+    .detail("witness_mover", c.witness.to_array());
+    match motion {
+        Some(Motion::Rotate { pivot, route, .. }) => {
+            v.detail("pivot_cell", pivot).detail("route", route)
+        }
         _ => v,
     }
 }

@@ -12,7 +12,9 @@ use std::io::Cursor;
 /// The check whose findings a kind of violation is.
 pub fn check_of(kind: ViolationKind) -> &'static str {
     match kind {
-        ViolationKind::Collision | ViolationKind::SlidingContact => "collision",
+        ViolationKind::Collision
+        | ViolationKind::SlidingContact
+        | ViolationKind::GroundCollision => "collision",
         ViolationKind::Unstable | ViolationKind::Overload => "mechanics",
         ViolationKind::DockingBlocked => "docking",
         _ => "lattice",

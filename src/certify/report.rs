@@ -36,6 +36,9 @@ pub enum ViolationKind {
     Collision,
     /// A mover slides in contact with a module that is not its pivot.
     SlidingContact,
+    /// A mover's body dips below the floor under the ground layer during
+    /// its sweep (geometry check).
+    GroundCollision,
     /// A docking's final approach is not clear by the exact geometry (seed
     /// 002): origin or passage occupied, a support missing, or a module
     /// penetrated along the sweep.
@@ -60,6 +63,7 @@ impl ViolationKind {
             self,
             ViolationKind::Collision
                 | ViolationKind::SlidingContact
+                | ViolationKind::GroundCollision
                 | ViolationKind::DockingBlocked
                 | ViolationKind::Unstable
                 | ViolationKind::Overload

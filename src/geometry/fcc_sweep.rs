@@ -11,10 +11,12 @@
 //!   set that is not a rotating mover (e.g. one leaving through a sink) is
 //!   treated as static — conservative.
 
+use super::ground::{GroundContact, floor_contact};
 use super::rolling::{Link, Roll};
 use super::rules::{offsets_within_reach, table};
 use super::sweep::{PairOutcome, Path, Sample, sweep_pair};
 use super::{Contact, ContactKind, EPSILON, SweepInput, SweepModel};
+use crate::lattice::config::Ground;
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Motion};
 use glam::DVec3;
@@ -90,6 +92,12 @@ pub fn rotations_clear(a: &Motion, b: &Motion) -> bool {
 }
 
 impl FccSweep {
+    /// Height of the floor under the ground layer: flush with the bottom
+    /// face of a catom at rest there (see [`super::ground`]).
+    pub fn floor(lattice: &dyn crate::lattice::Lattice, ground: Ground) -> f64 {
+        lattice.centre(Cell::new(0, 0, ground.layer)).z - super::catom().support(DVec3::NEG_Z)
+    }
+
     fn statics(
         &self,
         input: &SweepInput<'_>,
@@ -159,6 +167,18 @@ impl FccSweep {
 impl SweepModel for FccSweep {
     fn name(&self) -> &'static str {
         "fcc-catom"
+    }
+
+    fn check_ground(&self, input: &SweepInput<'_>, ground: Ground) -> Vec<GroundContact> {
+        let floor = Self::floor(input.lattice, ground);
+        input
+            .moves
+            .iter()
+            .filter_map(|(id, _, motion)| {
+                let roll = Roll::of_motion(input.lattice, motion)?;
+                floor_contact(*id, &roll, floor, input.epsilon.get())
+            })
+            .collect()
     }
 
     fn check_step(&self, input: &SweepInput<'_>) -> Vec<Contact> {

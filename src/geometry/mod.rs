@@ -10,13 +10,15 @@ pub mod atom_search;
 pub(crate) mod catom;
 pub mod docking;
 pub(crate) mod fcc_sweep;
+pub mod ground;
 pub(crate) mod rolling;
 pub(crate) mod rules;
 pub(crate) mod sweep;
 
-use crate::lattice::config::ModuleId;
+use crate::lattice::config::{Ground, ModuleId};
 use crate::lattice::{Configuration, Lattice, LatticeKind, Motion};
 use glam::DVec3;
+pub use ground::GroundContact;
 use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 
@@ -121,6 +123,16 @@ pub trait SweepModel: Send + Sync {
     fn name(&self) -> &'static str;
     /// All collisions and sliding contacts of one step's concurrent moves.
     fn check_step(&self, input: &SweepInput<'_>) -> Vec<Contact>;
+
+    /// The moves of the step that dig deeper than ε into the scene's
+    /// ground. The default reports none: right for a body model whose
+    /// movers never leave the cells at or above the ground layer (the
+    /// square lattice's axis-aligned paths, which stay within the rows of
+    /// their start and target cells).
+    fn check_ground(&self, input: &SweepInput<'_>, ground: Ground) -> Vec<GroundContact> {
+        let _ = (input, ground);
+        Vec::new()
+    }
 }
 
 /// The sweep model of a lattice, if this build has a body model for it.
