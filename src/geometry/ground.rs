@@ -186,8 +186,9 @@ pub fn floor_contact(mover: ModuleId, roll: &Roll, floor: f64, eps: f64) -> Opti
         low = lowest_point(&Roll::new(DVec3::ZERO, roll.link), bracket);
         (deep, reached) = depths(&low);
     }
-    // `!(deep <= eps)` so that a NaN height reads as a collision.
-    (!(deep <= eps)).then(|| GroundContact {
+    // A NaN height reads as a collision, never as a clearance.
+    let clear = deep.partial_cmp(&eps).is_some_and(|o| o.is_le());
+    (!clear).then(|| GroundContact {
         mover,
         s: low.s,
         depth: deep,
