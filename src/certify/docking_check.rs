@@ -6,11 +6,15 @@
 //! lattice's bodies (`geometry::docking`); the paper's Rule 1 plays no part.
 //! A blocked docking is reported with the step, the module, the blocking
 //! cells, and whether any other approach into the cell would be clear.
+//!
+//! The origin must also be reachable: a module has to get there from
+//! outside the structure, so an origin walled in by modules (and the
+//! ground) is a blocked docking too, whatever its sweep.
 
 use super::report::{Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
 use crate::geometry::Tolerance;
-use crate::geometry::docking::{Approach, clear_approaches, judge};
+use crate::geometry::docking::{Approach, bounds_of, clear_approaches, judge, origin_reachable};
 
 /// The final-approach check of every `dock` event.
 #[derive(Debug, Default)]
@@ -70,16 +74,30 @@ impl StepCheck for DockingCheck {
                 pivot: pivot_cell,
                 motion: d.motion.clone(),
             };
-            let verdict = judge(lattice, config, &approach, self.epsilon);
-            if verdict.is_clear() && !plan.moving.contains(&d.pivot) {
+            let ground = w.ground();
+            let bounds = bounds_of(config);
+            let verdict = judge(lattice, config, ground, &approach, self.epsilon);
+            let reachable = !verdict.is_clear()
+                || origin_reachable(lattice, config, ground, bounds, approach.from);
+            if verdict.is_clear() && reachable && !plan.moving.contains(&d.pivot) {
                 continue;
             }
-            let others = clear_approaches(lattice, config, cell, self.epsilon);
+            let others = clear_approaches(lattice, config, ground, bounds, cell, self.epsilon);
             let mut cells = verdict.blocking.clone();
             cells.extend(verdict.missing_supports.iter().copied());
             let mut why = Vec::new();
             if !verdict.blocking.is_empty() {
                 why.push(format!("blocked by {}", list(&verdict.blocking)));
+            }
+            if let Some(depth) = verdict.below_floor {
+                why.push(format!("its sweep dips {depth:.3e} d below the floor"));
+            }
+            if !reachable {
+                cells.push(approach.from);
+                why.push(format!(
+                    "its origin {} is enclosed: no free path reaches it from outside the structure",
+                    approach.from
+                ));
             }
             if !verdict.missing_supports.is_empty() {
                 why.push(format!(

@@ -6,15 +6,19 @@
 //! lattice the candidates are the sliding-square moves ending in the cell
 //! (`lattice::square`): four straight slides from a side neighbour, each
 //! along one of two walls, and four corner moves from a diagonal
-//! neighbour, each around one of two pivots — 16 in all. Whether an
+//! neighbour, each around one of two pivots — 16 in all. On the FCC
+//! lattice they are the catom rotations ending in the cell: about any of
+//! its 12 neighbours, from any neighbour of that pivot the rolling links
+//! reach, by either route. Whether an
 //! approach is clear is decided by the body geometry: the origin must be
 //! free, the move's supports held, and the exact sweep of the mover
 //! ([`super::sweep_model`]) must penetrate no module. Rule 1 of the paper
 //! is not consulted here; it lives with the generator.
 
+use super::rolling::Link;
 use super::{Contact, ContactKind, SweepInput, Tolerance, sweep_model};
-use crate::lattice::config::ModuleId;
-use crate::lattice::{Cell, Configuration, Lattice, LatticeKind, Motion};
+use crate::lattice::config::{Ground, ModuleId};
+use crate::lattice::{Cell, Configuration, Lattice, LatticeKind, Motion, Route};
 use rustc_hash::FxHashSet;
 
 /// Cells around a mover's origin whose modules its sweep can touch.
@@ -30,13 +34,49 @@ pub struct Approach {
     pub motion: Motion,
 }
 
-/// Every lattice move that ends in `cell`, on the square lattice (16).
-/// Other lattices have none here.
+/// Every lattice move that ends in `cell`: 16 on the square lattice, the
+/// rolling links into it on FCC. Other lattices have none here.
 pub fn candidates(lattice: &dyn Lattice, cell: Cell) -> Vec<Approach> {
-    let mut out = Vec::new();
-    if lattice.kind() != LatticeKind::Square {
-        return out;
+    match lattice.kind() {
+        LatticeKind::Square => square_candidates(lattice, cell),
+        LatticeKind::Fcc => fcc_candidates(lattice, cell),
+        LatticeKind::Cubic => Vec::new(),
     }
+}
+
+/// The catom rotations into `cell`: pivot any neighbour, origin any other
+/// neighbour of the pivot that a rolling link joins to `cell`.
+fn fcc_candidates(lattice: &dyn Lattice, cell: Cell) -> Vec<Approach> {
+    let mut out = Vec::new();
+    for pivot in lattice.neighbours(cell) {
+        for from in lattice.neighbours(pivot) {
+            if from == cell {
+                continue;
+            }
+            for route in [Route::Hexagonal, Route::Octagonal] {
+                let motion = Motion::Rotate {
+                    from,
+                    to: cell,
+                    pivot,
+                    route,
+                };
+                if Link::of_motion(lattice, &motion).is_some()
+                    && lattice.move_requirements(&motion).is_ok()
+                {
+                    out.push(Approach {
+                        from,
+                        pivot,
+                        motion,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+fn square_candidates(lattice: &dyn Lattice, cell: Cell) -> Vec<Approach> {
+    let mut out = Vec::new();
     let axes = [
         Cell::xy(1, 0),
         Cell::xy(0, 1),
@@ -82,24 +122,33 @@ pub struct Obstruction {
     pub blocking: Vec<Cell>,
     /// Supports the move needs that hold no module.
     pub missing_supports: Vec<Cell>,
+    /// How deep the sweep dips below the floor under the ground layer, if
+    /// it does (units of d).
+    pub below_floor: Option<f64>,
 }
 
 impl Obstruction {
     pub fn is_clear(&self) -> bool {
-        self.blocking.is_empty() && self.missing_supports.is_empty()
+        self.blocking.is_empty() && self.missing_supports.is_empty() && self.below_floor.is_none()
     }
 }
 
 /// Judges one approach against `config` (the scene before the docking):
-/// supports held, origin and passage free, and no penetration along the
-/// exact sweep of the mover (sliding contact is allowed, as for any move).
+/// supports held, origin and passage free and above the ground, no
+/// penetration along the exact sweep of the mover (sliding contact is
+/// allowed, as for any move), and no dip below the floor.
 pub fn judge(
     lattice: &'static dyn Lattice,
     config: &Configuration,
+    ground: Option<Ground>,
     approach: &Approach,
     epsilon: Tolerance,
 ) -> Obstruction {
     let mut out = Obstruction::default();
+    if ground.is_some_and(|g| g.is_ground_cell(lattice, approach.from)) {
+        out.blocking.push(approach.from);
+        return out;
+    }
     let Ok(req) = lattice.move_requirements(&approach.motion) else {
         out.blocking.push(approach.from);
         return out;
@@ -158,6 +207,9 @@ pub fn judge(
         epsilon,
         exact: true,
     };
+    if let Some(g) = ground {
+        out.below_floor = model.check_ground(&input, g).first().map(|c| c.depth);
+    }
     let contacts: Vec<Contact> = model.check_step(&input);
     for c in contacts.iter().filter(|c| c.kind == ContactKind::Collision) {
         if let Some(cell) = config.cell_of(c.other)
@@ -169,17 +221,97 @@ pub fn judge(
     out
 }
 
-/// The clear approaches into `cell` (see [`judge`]), in [`candidates`] order.
+/// The usable approaches into `cell`, in [`candidates`] order: clear (see
+/// [`judge`]) from an origin a module can reach from outside the
+/// structure, whose bounding box is `bounds` (see [`origin_reachable`]).
 pub fn clear_approaches(
     lattice: &'static dyn Lattice,
     config: &Configuration,
+    ground: Option<Ground>,
+    bounds: (Cell, Cell),
     cell: Cell,
     epsilon: Tolerance,
 ) -> Vec<Approach> {
     candidates(lattice, cell)
         .into_iter()
-        .filter(|a| judge(lattice, config, a, epsilon).is_clear())
+        .filter(|a| {
+            judge(lattice, config, ground, a, epsilon).is_clear()
+                && origin_reachable(lattice, config, ground, bounds, a.from)
+        })
         .collect()
+}
+
+/// The bounding box of the occupied cells (an empty box for no cells).
+pub fn bounds_of(config: &Configuration) -> (Cell, Cell) {
+    config.iter().fold(
+        (
+            Cell::new(i32::MAX, i32::MAX, i32::MAX),
+            Cell::new(i32::MIN, i32::MIN, i32::MIN),
+        ),
+        |(lo, hi), (_, c)| {
+            (
+                Cell::new(lo.x.min(c.x), lo.y.min(c.y), lo.z.min(c.z)),
+                Cell::new(hi.x.max(c.x), hi.y.max(c.y), hi.z.max(c.z)),
+            )
+        },
+    )
+}
+
+/// Most free cells an [`origin_reachable`] search visits before it gives
+/// up (and the origin counts as enclosed: the conservative answer).
+pub const REACH_SEARCH_LIMIT: usize = 200_000;
+
+/// Whether a module can come to `origin` from outside the structure: a
+/// path of free lattice neighbours (above the ground) from `origin` to a
+/// cell outside the bounding box `(lo, hi)` of the occupied cells. Free
+/// cells are a necessary condition for a real path, not a planned one. The
+/// search goes best-first towards the nearest face of the box, so an open
+/// origin costs a few cells; an enclosed one costs its cavity.
+pub fn origin_reachable(
+    lattice: &dyn Lattice,
+    config: &Configuration,
+    ground: Option<Ground>,
+    bounds: (Cell, Cell),
+    origin: Cell,
+) -> bool {
+    use std::cmp::Reverse;
+    let (lo, hi) = bounds;
+    let outside =
+        |c: Cell| c.x < lo.x || c.y < lo.y || c.z < lo.z || c.x > hi.x || c.y > hi.y || c.z > hi.z;
+    let to_face = |c: Cell| {
+        [
+            c.x - lo.x,
+            hi.x - c.x,
+            c.y - lo.y,
+            hi.y - c.y,
+            c.z - lo.z,
+            hi.z - c.z,
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+        .max(0)
+    };
+    let open = |c: Cell| config.is_free(c) && !ground.is_some_and(|g| g.is_ground_cell(lattice, c));
+    if !open(origin) {
+        return false;
+    }
+    let mut seen: FxHashSet<Cell> = [origin].into_iter().collect();
+    let mut heap = std::collections::BinaryHeap::from([Reverse((to_face(origin), origin))]);
+    while let Some(Reverse((_, c))) = heap.pop() {
+        if outside(c) {
+            return true;
+        }
+        if seen.len() > REACH_SEARCH_LIMIT {
+            return false;
+        }
+        for n in lattice.neighbours(c) {
+            if open(n) && seen.insert(n) {
+                heap.push(Reverse((to_face(n), n)));
+            }
+        }
+    }
+    false
 }
 
 #[cfg(test)]
@@ -203,7 +335,14 @@ mod tests {
     #[test]
     fn a_cell_beside_one_module_is_reached_around_its_corner() {
         let c = scene(&[(1, 0)]);
-        let ok = clear_approaches(&SquareLattice, &c, Cell::xy(0, 0), Tolerance::DEFAULT);
+        let ok = clear_approaches(
+            &SquareLattice,
+            &c,
+            None,
+            bounds_of(&c),
+            Cell::xy(0, 0),
+            Tolerance::DEFAULT,
+        );
         assert!(ok.iter().any(|a| a.from == Cell::xy(1, 1)), "{ok:?}");
         // A module in the corner's passage blocks that approach.
         let c = scene(&[(1, 0), (0, 1)]);
@@ -211,7 +350,88 @@ mod tests {
             .into_iter()
             .find(|a| a.from == Cell::xy(1, 1) && a.pivot == Cell::xy(1, 0))
             .unwrap();
-        let o = judge(&SquareLattice, &c, &a, Tolerance::DEFAULT);
+        let o = judge(&SquareLattice, &c, None, &a, Tolerance::DEFAULT);
         assert_eq!(o.blocking, vec![Cell::xy(0, 1)]);
+    }
+
+    #[test]
+    fn an_origin_inside_a_closed_ring_is_enclosed_and_one_gap_opens_it() {
+        let ring = [
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ];
+        let c = scene(&ring);
+        let b = bounds_of(&c);
+        let o = Cell::xy(0, 0);
+        assert!(!origin_reachable(&SquareLattice, &c, None, b, o));
+        assert!(origin_reachable(
+            &SquareLattice,
+            &c,
+            None,
+            b,
+            Cell::xy(2, 0)
+        ));
+        let gap: Vec<(i32, i32)> = ring.iter().copied().filter(|&c| c != (0, 1)).collect();
+        let open = scene(&gap);
+        assert!(origin_reachable(
+            &SquareLattice,
+            &open,
+            None,
+            bounds_of(&open),
+            o
+        ));
+        // An occupied origin is never reachable.
+        assert!(!origin_reachable(
+            &SquareLattice,
+            &c,
+            None,
+            b,
+            Cell::xy(1, 0)
+        ));
+        // On FCC the ground closes a cup from below: a catom on the ground
+        // walled in on its four sides and capped is enclosed.
+        use crate::lattice::FccLattice;
+        let mut cup = Configuration::new();
+        let mut id = 0;
+        for cell in FccLattice.neighbours(Cell::new(0, 0, 0)) {
+            if cell.z >= 0 {
+                cup.insert(id, cell).unwrap();
+                id += 1;
+            }
+        }
+        let g = Some(Ground { layer: 0 });
+        let b = bounds_of(&cup);
+        assert!(!origin_reachable(
+            &FccLattice,
+            &cup,
+            g,
+            b,
+            Cell::new(0, 0, 0)
+        ));
+        assert!(origin_reachable(
+            &FccLattice,
+            &cup,
+            None,
+            b,
+            Cell::new(0, 0, 0)
+        ));
+    }
+
+    #[test]
+    fn a_catom_cell_has_rotations_into_it_about_each_neighbour() {
+        use crate::lattice::FccLattice;
+        let c = candidates(&FccLattice, Cell::new(0, 0, 0));
+        let pivots: FxHashSet<Cell> = c.iter().map(|a| a.pivot).collect();
+        assert_eq!(pivots.len(), 12);
+        assert!(
+            c.iter()
+                .all(|a| matches!(a.motion, Motion::Rotate { to, .. } if to == Cell::ZERO))
+        );
     }
 }

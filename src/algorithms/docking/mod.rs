@@ -22,7 +22,7 @@ pub mod rule1;
 use super::{Generator, parameters};
 use crate::error::InputError;
 use crate::geometry::Tolerance;
-use crate::geometry::docking::{Approach, candidates, clear_approaches};
+use crate::geometry::docking::{Approach, candidates, clear_approaches, judge};
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Configuration, LatticeKind, SquareLattice};
 use crate::scenario::Scenario;
@@ -100,9 +100,10 @@ pub fn plan(
 }
 
 /// The schedule of a run: the seed fixed in place, then one docking per
-/// step. Each docking's approach is the first clear one on the module that
-/// attracted it, else the first clear one, else (none clear) a corner
-/// approach on the attractor, left for certification to refuse.
+/// step. Each docking's approach is the first usable one (clear, from an
+/// origin reachable from outside) on the module that attracted it, else
+/// the first usable one, else (none) a corner approach on the attractor,
+/// left for certification to refuse.
 fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
     let lattice = &SquareLattice;
     let mut s = Schedule::new(LatticeKind::Square, Length::mm(50.0));
@@ -114,12 +115,13 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         fixed: true,
     });
     config.insert(0, seed).expect("empty scene");
+    let mut bounds = (seed, seed);
     let mut without = 0;
     for (k, d) in run.order.iter().enumerate().skip(1) {
         let id = k as ModuleId;
         let cell = Cell::xy(d.cell.0, d.cell.1);
         let attractor = d.attractor.map(|(x, y)| Cell::xy(x, y));
-        let clear = clear_approaches(lattice, &config, cell, Tolerance::DEFAULT);
+        let clear = clear_approaches(lattice, &config, None, bounds, cell, Tolerance::DEFAULT);
         let pick = |list: &[Approach]| -> Option<Approach> {
             list.iter()
                 .find(|a| Some(a.pivot) == attractor)
@@ -129,6 +131,16 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         let approach = pick(&clear).unwrap_or_else(|| {
             without += 1;
             let all = candidates(lattice, cell);
+            // A sweep that is clear from an enclosed origin, if any: the
+            // certifier then says why no module can get there.
+            let swept: Vec<Approach> = all
+                .iter()
+                .filter(|a| judge(lattice, &config, None, a, Tolerance::DEFAULT).is_clear())
+                .cloned()
+                .collect();
+            if let Some(a) = pick(&swept) {
+                return a;
+            }
             all.iter()
                 .find(|a| Some(a.pivot) == attractor && a.from.x != cell.x && a.from.y != cell.y)
                 .or_else(|| all.first())
@@ -148,6 +160,7 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         config
             .insert(id, cell)
             .expect("the planner docks a cell once");
+        bounds = grow(bounds, cell);
     }
     s.meta.insert("algorithm".into(), "docking".into());
     s.meta.insert("goal".into(), goal.name.clone().into());
@@ -158,6 +171,14 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         .insert("rule1_violations".into(), run.rule1_violations.into());
     s.meta.insert("unfilled".into(), run.unfilled.into());
     (s, without)
+}
+
+/// The bounding box `b` grown to hold `c`.
+pub fn grow(b: (Cell, Cell), c: Cell) -> (Cell, Cell) {
+    (
+        Cell::new(b.0.x.min(c.x), b.0.y.min(c.y), b.0.z.min(c.z)),
+        Cell::new(b.1.x.max(c.x), b.1.y.max(c.y), b.1.z.max(c.z)),
+    )
 }
 
 /// The `docking` generator.

@@ -2,7 +2,9 @@
 //!
 //! Supported: `cube(size | [x, y, z], center = bool)`, `sphere(r | radius
 //! = r)`, `cylinder(h | height = …, r | radius = …, center = bool)`,
-//! `translate([x, y, z]) object`, `union() { … }`, `difference() { … }`,
+//! `translate([x, y, z]) object`, `scale([x, y, z]) object` (positive
+//! factors), `rotate([a, b, c]) object` (degrees, OpenSCAD's order: about x
+//! by a, then y by b, then z by c), `union() { … }`, `difference() { … }`,
 //! `intersection() { … }`, assignments `name = expr;`, arithmetic
 //! (`+ - * /`, parentheses, `sqrt(…)`) and `//` comments. Lengths are in
 //! units of the lattice spacing d; z is up. Anything else is refused with
@@ -24,10 +26,32 @@ pub const MEMBERSHIP_TOL: f64 = 0.05;
 /// A CSG solid.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Node {
-    Cube { size: DVec3, center: bool },
-    Sphere { r: f64 },
-    Cylinder { h: f64, r: f64, center: bool },
-    Translate { v: DVec3, child: Box<Node> },
+    Cube {
+        size: DVec3,
+        center: bool,
+    },
+    Sphere {
+        r: f64,
+    },
+    Cylinder {
+        h: f64,
+        r: f64,
+        center: bool,
+    },
+    Translate {
+        v: DVec3,
+        child: Box<Node>,
+    },
+    /// Scaled by positive factors along x, y, z.
+    Scale {
+        s: DVec3,
+        child: Box<Node>,
+    },
+    /// Rotated by `r` (child frame → world), with its inverse kept.
+    Rotate {
+        r: glam::DMat3,
+        child: Box<Node>,
+    },
     Union(Vec<Node>),
     Difference(Vec<Node>),
     Intersection(Vec<Node>),
@@ -55,6 +79,11 @@ impl Node {
                 p.z >= z0 - tol && p.z <= z0 + h + tol && (p.x * p.x + p.y * p.y).sqrt() <= r + tol
             }
             Node::Translate { v, child } => child.contains_within(p - *v, tol),
+            // The child's offset divided by the smallest factor: the scaled
+            // solid is offset by at least `tol` in every direction (by up
+            // to `tol·max/min` along the most stretched axis).
+            Node::Scale { s, child } => child.contains_within(p / *s, tol / s.min_element()),
+            Node::Rotate { r, child } => child.contains_within(r.transpose() * p, tol),
             Node::Union(c) => c.iter().any(|n| n.contains_within(p, tol)),
             Node::Difference(c) => {
                 c.first().is_some_and(|f| f.contains_within(p, tol))
@@ -79,6 +108,27 @@ impl Node {
             Node::Translate { v, child } => {
                 let (a, b) = child.bounds();
                 (a + *v, b + *v)
+            }
+            Node::Scale { s, child } => {
+                let (a, b) = child.bounds();
+                (a * *s, b * *s)
+            }
+            Node::Rotate { r, child } => {
+                // The box of the rotated child's box: its eight corners.
+                let (a, b) = child.bounds();
+                (0..8)
+                    .map(|k| {
+                        let c = DVec3::new(
+                            if k & 1 == 0 { a.x } else { b.x },
+                            if k & 2 == 0 { a.y } else { b.y },
+                            if k & 4 == 0 { a.z } else { b.z },
+                        );
+                        *r * c
+                    })
+                    .fold(
+                        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                        |(lo, hi), c| (lo.min(c), hi.max(c)),
+                    )
             }
             Node::Union(c) => c
                 .iter()
@@ -291,6 +341,26 @@ impl Parser {
                 let child = self.block()?;
                 Node::Translate { v, child: Box::new(child) }
             }
+            "scale" => {
+                let s = match args.first() {
+                    Some((_, Val::Vec3(v))) if v.is_finite() && v.cmpgt(DVec3::ZERO).all() => *v,
+                    Some((_, Val::Num(k))) if k.is_finite() && *k > 0.0 => DVec3::splat(*k),
+                    _ => return Err(self.err("scale needs positive factors [x, y, z]")),
+                };
+                let child = self.block()?;
+                Node::Scale { s, child: Box::new(child) }
+            }
+            "rotate" => {
+                let a = match args.first() {
+                    Some((_, Val::Vec3(v))) if v.is_finite() => *v,
+                    _ => return Err(self.err("rotate needs angles [x, y, z] in degrees")),
+                };
+                let r = glam::DMat3::from_rotation_z(a.z.to_radians())
+                    * glam::DMat3::from_rotation_y(a.y.to_radians())
+                    * glam::DMat3::from_rotation_x(a.x.to_radians());
+                let child = self.block()?;
+                Node::Rotate { r, child: Box::new(child) }
+            }
             "union" | "difference" | "intersection" => {
                 let children = self.children()?;
                 match name.as_str() {
@@ -302,7 +372,7 @@ impl Parser {
             other => {
                 return Err(self.err(format!(
                     "unsupported CSG operation '{other}' (supported: cube, sphere, cylinder, translate, \
-                     union, difference, intersection)"
+                     scale, rotate, union, difference, intersection)"
                 )))
             }
         };
@@ -326,7 +396,7 @@ impl Parser {
                 ],
                 2,
             ),
-            "translate" => (&[], 1),
+            "translate" | "scale" | "rotate" => (&[], 1),
             "union" | "difference" | "intersection" => (&[], 0),
             _ => return Ok(args.into_iter().map(|(n, v, _)| (n, v)).collect()),
         };
@@ -565,13 +635,41 @@ mod tests {
 
     #[test]
     fn unsupported_operations_are_named_with_their_line() {
-        let e = CsgShape::parse("r", "cube(3);\nrotate([0,0,45]) cube(2);").unwrap_err();
+        let e = CsgShape::parse("r", "cube(3);\nmirror([1,0,0]) cube(2);").unwrap_err();
         assert!(
-            e.message.contains("line 2, column 1") && e.message.contains("rotate"),
+            e.message.contains("line 2, column 1") && e.message.contains("mirror"),
             "{}",
             e.message
         );
         let e = CsgShape::parse("c", "cylinder(h=3, r1=2, r2=1);").unwrap_err();
         assert!(e.message.contains("cones"), "{}", e.message);
+    }
+
+    #[test]
+    fn rotate_turns_a_cylinder_onto_y_and_scale_stretches_each_axis() {
+        // OpenSCAD: rotate([90, 0, 0]) takes +z to −y.
+        let c = CsgShape::parse(
+            "r",
+            "rotate([90, 0, 0]) cylinder(h = 10, r = 1, center = true);",
+        )
+        .unwrap();
+        assert!(c.root.contains(DVec3::new(0.0, 4.0, 0.0)));
+        assert!(!c.root.contains(DVec3::new(0.0, 0.0, 4.0)));
+        let (lo, hi) = c.root.bounds();
+        assert!(
+            (lo.y + 5.0).abs() < 1e-12 && (hi.z - 1.0).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        let e = CsgShape::parse("s", "scale([2, 1, 0.5]) sphere(1);").unwrap();
+        assert!(e.root.contains(DVec3::new(1.9, 0.0, 0.0)));
+        assert!(!e.root.contains(DVec3::new(0.0, 1.5, 0.0)));
+        assert!(!e.root.contains(DVec3::new(0.0, 0.0, 0.7)));
+        for bad in [
+            "scale([2, 0, 1]) cube(1);",
+            "scale([2, -1, 1]) cube(1);",
+            "rotate(45) cube(1);",
+        ] {
+            assert!(CsgShape::parse("b", bad).is_err(), "{bad}");
+        }
     }
 }
