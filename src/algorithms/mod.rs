@@ -39,6 +39,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &branch::Branch,
         &scaffold::ScaffoldAssembly,
         &docking::Docking,
+        &docking::Docking3d,
         &comb::Comb2d,
         &repost::RepostOperation,
         &repost::Repost,

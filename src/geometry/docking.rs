@@ -257,6 +257,54 @@ pub fn bounds_of(config: &Configuration) -> (Cell, Cell) {
     )
 }
 
+/// Whether the motion rules (the compiled tables, not an exact sweep)
+/// find `approach` clear in `config`: origin free and above the ground,
+/// pivot and supports held, every cell the sweep penetrates free — and,
+/// when `strict`, every cell it touches too — and no dip below the floor.
+/// What a generator plans with; certification judges exactly ([`judge`]).
+pub fn planned_clear(
+    lattice: &dyn Lattice,
+    config: &Configuration,
+    ground: Option<Ground>,
+    approach: &Approach,
+    strict: bool,
+) -> bool {
+    let free = |c: Cell| config.is_free(c) && !ground.is_some_and(|g| g.is_ground_cell(lattice, c));
+    if !free(approach.from) || config.is_free(approach.pivot) {
+        return false;
+    }
+    let Ok(req) = lattice.move_requirements(&approach.motion) else {
+        return false;
+    };
+    if req.supports.iter().any(|c| config.is_free(*c)) || !req.pass_through.iter().all(|c| free(*c))
+    {
+        return false;
+    }
+    if let Some(rules) = super::motion_rules(lattice.kind()) {
+        let cells = if strict {
+            rules.touched_cells(&approach.motion)
+        } else {
+            rules.blocking_cells(&approach.motion)
+        };
+        if !cells
+            .into_iter()
+            .all(|c| c == approach.motion.to() || free(c))
+        {
+            return false;
+        }
+    }
+    if let (Some(g), Some(roll)) = (
+        ground,
+        super::rolling::Roll::of_motion(lattice, &approach.motion),
+    ) {
+        let floor = super::FccSweep::floor(lattice, g);
+        if super::ground::floor_contact(0, &roll, floor, super::EPSILON).is_some() {
+            return false;
+        }
+    }
+    true
+}
+
 /// Most free cells an [`origin_reachable`] search visits before it gives
 /// up (and the origin counts as enclosed: the conservative answer).
 pub const REACH_SEARCH_LIMIT: usize = 200_000;
