@@ -14,8 +14,10 @@
 
 use super::goal::Goal;
 use super::rule1::blocked_2d;
+use crate::lattice::Cell;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -55,7 +57,8 @@ pub fn run(goal: &Goal, seed_cell: (i32, i32), order: Order, seed: u64) -> Naive
     }
 }
 
-/// One growth: returns (Rule 1 violations, cells filled).
+/// One growth on the square lattice: returns (Rule 1 violations, cells
+/// filled).
 fn grow(
     goal: &Goal,
     seed_cell: (i32, i32),
@@ -63,33 +66,77 @@ fn grow(
     seed: u64,
     refuse: bool,
 ) -> (usize, usize) {
-    let slot = |x: i32, y: i32| goal.slot(x, y);
-    let mut filled = vec![false; goal.slots()];
-    let mut queued = vec![false; goal.slots()];
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (mut violations, mut count) = (0, 0);
     let sides = [(1, 0), (0, 1), (-1, 0), (0, -1)];
-    // Frontier: free goal cells next to the structure, in the order's data
-    // structure (a bag for random, a queue for the neighbourhood fill).
-    let mut frontier: VecDeque<(i32, i32)> = VecDeque::new();
-    let mut place = |c: (i32, i32),
-                     filled: &mut Vec<bool>,
-                     queued: &mut Vec<bool>,
-                     frontier: &mut VecDeque<(i32, i32)>| {
-        filled[slot(c.0, c.1).expect("goal cell")] = true;
-        count += 1;
-        for (dx, dy) in sides {
-            let n = (c.0 + dx, c.1 + dy);
-            if goal.contains(n.0, n.1) {
-                let k = slot(n.0, n.1).expect("goal cell");
-                if !filled[k] && !queued[k] {
-                    queued[k] = true;
+    grow_on(
+        seed_cell,
+        &|c: (i32, i32)| goal.contains(c.0, c.1),
+        &|c: (i32, i32)| sides.iter().map(|d| (c.0 + d.0, c.1 + d.1)).collect(),
+        &|occupied: &dyn Fn((i32, i32)) -> bool, c: (i32, i32)| {
+            blocked_2d(&|x, y| occupied((x, y)), c.0, c.1)
+        },
+        order,
+        seed,
+        refuse,
+    )
+}
+
+/// Runs `order` on a 3D goal on the FCC lattice from `seed_cell`, Rule 1
+/// as the authors coded it in 3D ([`super::rule1::blocked_fcc`]), the
+/// frontier over the 12 neighbours.
+pub fn run_fcc(
+    goal: &super::plane_by_plane::Goal3,
+    seed_cell: Cell,
+    order: Order,
+    seed: u64,
+) -> NaiveCounts {
+    use crate::lattice::{FccLattice, Lattice};
+    let go = |refuse| {
+        grow_on(
+            seed_cell,
+            &|c: Cell| goal.cells.contains(&c),
+            &|c: Cell| FccLattice.neighbours(c).into_iter().collect(),
+            &|occupied: &dyn Fn(Cell) -> bool, c: Cell| super::rule1::blocked_fcc(occupied, c),
+            order,
+            seed,
+            refuse,
+        )
+    };
+    let (violations, _) = go(false);
+    let (_, filled) = go(true);
+    NaiveCounts {
+        violations,
+        unfillable: goal.len() - filled,
+    }
+}
+
+/// One growth over any cells: the frontier (free goal cells next to the
+/// structure) is a bag drawn at random or a first-in-first-out queue.
+/// Returns (Rule 1 violations, cells filled).
+#[allow(clippy::type_complexity)]
+fn grow_on<C: Copy + Eq + std::hash::Hash>(
+    start: C,
+    in_goal: &dyn Fn(C) -> bool,
+    neighbours: &dyn Fn(C) -> Vec<C>,
+    blocked: &dyn Fn(&dyn Fn(C) -> bool, C) -> bool,
+    order: Order,
+    seed: u64,
+    refuse: bool,
+) -> (usize, usize) {
+    let mut filled: FxHashSet<C> = FxHashSet::default();
+    let mut queued: FxHashSet<C> = FxHashSet::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut violations = 0;
+    let mut frontier: VecDeque<C> = VecDeque::new();
+    let place =
+        |c: C, filled: &mut FxHashSet<C>, queued: &mut FxHashSet<C>, frontier: &mut VecDeque<C>| {
+            filled.insert(c);
+            for n in neighbours(c) {
+                if in_goal(n) && !filled.contains(&n) && queued.insert(n) {
                     frontier.push_back(n);
                 }
             }
-        }
-    };
-    place(seed_cell, &mut filled, &mut queued, &mut frontier);
+        };
+    place(start, &mut filled, &mut queued, &mut frontier);
     loop {
         let next = match order {
             Order::Random => {
@@ -102,8 +149,7 @@ fn grow(
             Order::Neighbourhood => frontier.pop_front(),
         };
         let Some(c) = next else { break };
-        let occupied = |x: i32, y: i32| slot(x, y).is_some_and(|k| filled[k]);
-        if blocked_2d(&occupied, c.0, c.1) {
+        if blocked(&|x| filled.contains(&x), c) {
             violations += 1;
             if refuse {
                 continue;
@@ -111,5 +157,5 @@ fn grow(
         }
         place(c, &mut filled, &mut queued, &mut frontier);
     }
-    (violations, count)
+    (violations, filled.len())
 }
