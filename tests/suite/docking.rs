@@ -450,3 +450,68 @@ fn naive_orders_in_3d_break_rule1_where_the_plane_by_plane_planner_does_not() {
     assert!(fill.violations > 0 && fill.unfillable > 0, "{fill:?}");
     assert!(random.violations > fill.violations, "{random:?} {fill:?}");
 }
+
+#[test]
+fn rule1_against_the_catom_geometry_on_fcc_by_enumeration() {
+    // Every occupancy of the 12 neighbours of a free FCC cell (4,095 with
+    // at least one module): does the authors' 3D Rule 1 allow a docking,
+    // and does any catom rotation into the cell have a clear sweep from a
+    // reachable origin? Cells further away are free. The sweeps are
+    // judged by the compiled tables, each the exact sweep against one
+    // catom; every 64th layout is judged again by the exact sweep.
+    use reconfcheck::algorithms::docking::rule1::blocked_fcc;
+    use reconfcheck::geometry::docking::{
+        bounds_of, candidates, judge, origin_reachable, planned_clear,
+    };
+    use reconfcheck::lattice::{FccLattice, Lattice};
+    let l = &FccLattice;
+    let p = Cell::ZERO;
+    let shell = l.neighbours(p);
+    let (mut looser, mut stricter, mut both_forbid, mut example) = (0, 0, 0, None);
+    for mask in 1u32..4096 {
+        let occ: Vec<Cell> = (0..12)
+            .filter(|k| mask & (1 << k) != 0)
+            .map(|k| shell[k])
+            .collect();
+        let mut config = Configuration::new();
+        for (k, c) in occ.iter().enumerate() {
+            config.insert(k as u32, *c).unwrap();
+        }
+        let b = bounds_of(&config);
+        let cands = candidates(l, p);
+        let usable = |a: &reconfcheck::geometry::docking::Approach| {
+            planned_clear(l, &config, None, a, false)
+                && origin_reachable(l, &config, None, b, a.from)
+        };
+        if mask % 64 == 0 {
+            for a in cands
+                .iter()
+                .filter(|a| !config.is_free(a.pivot) && config.is_free(a.from))
+            {
+                let exact = judge(l, &config, None, a, Tolerance::DEFAULT).is_clear();
+                assert_eq!(
+                    planned_clear(l, &config, None, a, false),
+                    exact,
+                    "{mask:#x} {a:?}"
+                );
+            }
+        }
+        let geometry_allows = cands.iter().any(usable);
+        let rule1_allows = !blocked_fcc(&|c| occ.contains(&c), p);
+        match (rule1_allows, geometry_allows) {
+            (true, false) => looser += 1,
+            (false, true) => {
+                stricter += 1;
+                example.get_or_insert(occ.clone());
+            }
+            (false, false) => both_forbid += 1,
+            _ => {}
+        }
+    }
+    println!(
+        "FCC: Rule 1 stricter in {stricter} (e.g. {example:?}), looser in {looser}, both forbid {both_forbid}"
+    );
+    // Rule 1 is never looser than the catom: no layout it allows lacks a
+    // clear approach. It forbids 436 layouts the geometry allows.
+    assert_eq!((stricter, looser, both_forbid), (436, 0, 3181));
+}
