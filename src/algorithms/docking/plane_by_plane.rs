@@ -78,6 +78,16 @@ impl Goal3 {
             ))
         })?;
         let dz = zmin - zmin.rem_euclid(2);
+        let lim = crate::schedule::MAX_COORDINATE - 2;
+        if cells
+            .iter()
+            .any(|c| c.x.abs() > lim || c.y.abs() > lim || (c.z - dz).abs() > lim)
+        {
+            return Err(InputError::new(format!(
+                "goal '{}' lies off the lattice: cells beyond ±{lim}",
+                shape.name
+            )));
+        }
         let g = Goal3 {
             name: shape.name.clone(),
             cells: cells
