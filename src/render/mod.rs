@@ -12,6 +12,7 @@ use std::sync::{Arc, OnceLock};
 mod b_study;
 mod catom;
 pub mod density;
+pub mod docking_figures;
 mod loadmap;
 mod placed;
 pub mod scaffold_figures;

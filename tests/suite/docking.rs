@@ -547,3 +547,86 @@ fn rule1_against_the_catom_geometry_on_fcc_by_enumeration() {
     // clear approach. It forbids 436 layouts the geometry allows.
     assert_eq!((stricter, looser, both_forbid), (436, 0, 3181));
 }
+
+/// `docking-study --seeds 1 --factor 1 --plot-dir DIR` on the bundled shapes.
+#[cfg(feature = "render")]
+fn docking_study_plots(dir: &Path) -> std::process::Output {
+    bin()
+        .args(["docking-study", "--seeds", "1", "--factor", "1", "--models"])
+        .arg(models())
+        .arg("--plot-dir")
+        .arg(dir)
+        .output()
+        .unwrap()
+}
+
+#[cfg(feature = "render")]
+#[test]
+fn the_docking_study_draws_figs_10_and_11_with_every_shape() {
+    use reconfcheck::render::docking_figures::{COLOURS, SIZE};
+    let dir = common::scratch_dir("docking-plots");
+    let out = docking_study_plots(&dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("fig10.png") && err.contains("fig11.png"),
+        "{err}"
+    );
+    for name in ["fig10.png", "fig11.png"] {
+        let path = dir.join(name);
+        let png = resvg::tiny_skia::Pixmap::load_png(&path)
+            .unwrap_or_else(|e| panic!("{}: not a PNG: {e}", path.display()));
+        assert_eq!((png.width(), png.height()), SIZE, "{name}");
+        // Inside the axes, below the legend (which is in the top quarter):
+        // many colours, among them every shape's own.
+        let (w, h) = (png.width() as usize, png.height() as usize);
+        let plot: Vec<[u8; 3]> = png
+            .pixels()
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| {
+                let (x, y) = (i % w, i / w);
+                x > w / 8 && x < w * 19 / 20 && y > h / 4 && y < h * 17 / 20
+            })
+            .map(|(_, c)| [c.red(), c.green(), c.blue()])
+            .collect();
+        let distinct: std::collections::HashSet<&[u8; 3]> = plot.iter().collect();
+        assert!(distinct.len() > 10, "{name}: {} colours", distinct.len());
+        for (k, want) in COLOURS.iter().enumerate() {
+            let drawn = plot
+                .iter()
+                .filter(|c| (0..3).all(|j| c[j].abs_diff(want[j]) <= 30))
+                .count();
+            // The series itself, not only its legend entry.
+            assert!(
+                drawn > 40,
+                "{name}: {} drawn in {drawn} pixels",
+                SHAPES[k].0
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(feature = "render")]
+#[test]
+fn a_bad_plot_dir_is_refused_before_the_study_and_a_failed_write_is_exit_3() {
+    let dir = common::scratch_dir("docking-plot-dir");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    for bad in [dir.join("missing"), file] {
+        let out = docking_study_plots(&bad);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains("--plot-dir"), "{err}");
+        assert!(err.contains(&bad.display().to_string()), "{err}");
+        assert!(out.stdout.is_empty(), "the study ran before the refusal");
+    }
+    // A folder in the way of fig10.png: the study runs, the write fails.
+    std::fs::create_dir_all(dir.join("fig10.png")).unwrap();
+    let out = docking_study_plots(&dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("fig10.png"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
