@@ -630,3 +630,24 @@ fn a_bad_plot_dir_is_refused_before_the_study_and_a_failed_write_is_exit_3() {
     assert!(err.contains("fig10.png"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn counted_as_the_paper_era_code_counts_the_permissions_cost_more_than_the_later_code() {
+    // A filled 30 × 30 square (no hole: no border following). The later
+    // code sends one reply per permission (≈ 2.93n with the initial 2n);
+    // the paper-era code also sends the requests and an unasked reply on
+    // every initial request, most of them redundant.
+    let cells: Vec<(i32, i32)> = (0..30).flat_map(|x| (0..30).map(move |y| (x, y))).collect();
+    let g = Goal::from_cells("square", &cells).unwrap();
+    let r = planner::run(&g, (15, 15), 0, &Delays::default());
+    let m = r.messages;
+    let n = g.len() as f64;
+    assert_eq!(m.sync, 0);
+    assert!((m.total() as f64 / n - 2.93).abs() < 0.02, "{m:?}");
+    assert!(
+        m.reply <= m.request && m.request > 0 && m.unasked > m.reply,
+        "{m:?}"
+    );
+    let paper = m.total_paper() as f64 / n;
+    assert!((3.9..4.4).contains(&paper), "{paper} {m:?}");
+}

@@ -71,20 +71,50 @@ pub struct Docking {
     pub time: u64,
 }
 
-/// Message counts, as the paper defines them.
+/// Message counts, as the authors' simulator counts them.
+///
+/// Two versions of their code count the permissions differently (read in
+/// ProgrammableMatterProject/VisibleSim, `applicationsSrc/reconfCatoms3D`):
+///
+/// * **paper-era** (85228ead, Nov. 2017, the code behind the paper's ≈ 5n):
+///   an arriving module that needs a corner to attract sideways sends a
+///   "can fill left/right" request to the neighbour next to it (1), which
+///   replies at once if the corner is there (1) and drops it otherwise;
+///   and every module that receives an arrival's initial request also
+///   sends, unasked, a "can fill left" reply to its north when it has
+///   north and west neighbours and a "can fill right" reply to its south
+///   when it has east and south ones (1 each) — one of which delivers a
+///   dropped permission, most of which are redundant;
+/// * **later** (77ca516c, "lower number of messages", Dec. 2017, the code
+///   the facts file describes): one reply per permission, no request.
+///
+/// Both count the initial exchange (≈ 2n) and two per hop of a
+/// border-following reply alike.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Messages {
     /// Initial information exchange of each arriving module (≈ 2n).
     pub initial: u64,
-    /// "Can fill left/right" permission replies through a side neighbour.
+    /// Later code: "can fill left/right" replies, one per permission.
     pub permission: u64,
     /// Border-following (synchronisation) replies, two per hop.
     pub sync: u64,
+    /// Paper-era code: permission requests of arriving modules.
+    pub request: u64,
+    /// Paper-era code: replies to those requests (the corner was there).
+    pub reply: u64,
+    /// Paper-era code: unasked replies sent on every initial request.
+    pub unasked: u64,
 }
 
 impl Messages {
+    /// The total as the later code counts it (≈ 2.9n).
     pub fn total(&self) -> u64 {
         self.initial + self.permission + self.sync
+    }
+
+    /// The total as the paper-era code counts it (≈ 5n, the paper's).
+    pub fn total_paper(&self) -> u64 {
+        self.initial + self.request + self.reply + self.unasked + self.sync
     }
 }
 
@@ -272,6 +302,45 @@ impl Sim<'_> {
         }
     }
 
+    /// The paper-era permission messages of a module arriving at `(x, y)`
+    /// (see [`Messages`]); `in_row` when its initial requests go to its
+    /// x-neighbours (else to its y-neighbours, as a line's start).
+    fn paper_era_permissions(&mut self, x: i32, y: i32, in_row: bool) {
+        let f = |a: i32, b: i32| self.is_filled(a, b);
+        let g = |a: i32, b: i32| self.in_goal(a, b);
+        let (mut request, mut reply, mut unasked) = (0, 0, 0);
+        // West needs the south-west corner, asked of the south neighbour;
+        // east needs the north-east corner, asked of the north neighbour.
+        for (side, corner, asked) in [
+            ((x - 1, y), (x - 1, y - 1), (x, y - 1)),
+            ((x + 1, y), (x + 1, y + 1), (x, y + 1)),
+        ] {
+            if g(side.0, side.1)
+                && !f(side.0, side.1)
+                && g(corner.0, corner.1)
+                && f(asked.0, asked.1)
+            {
+                request += 1;
+                if f(corner.0, corner.1) {
+                    reply += 1;
+                }
+            }
+        }
+        // Every neighbour that gets an initial request replies unasked.
+        let told: Vec<(i32, i32)> = if in_row {
+            vec![(x - 1, y), (x + 1, y)]
+        } else {
+            vec![(x, y - 1), (x, y + 1)]
+        };
+        for (a, b) in told.into_iter().filter(|&(a, b)| f(a, b)) {
+            unasked +=
+                u64::from(f(a, b + 1) && f(a - 1, b)) + u64::from(f(a + 1, b) && f(a, b - 1));
+        }
+        self.run.messages.request += request;
+        self.run.messages.reply += reply;
+        self.run.messages.unasked += unasked;
+    }
+
     fn dock(&mut self, k: usize, by: Option<usize>) {
         let (x, y) = self.xy(k);
         let occupied = |a: i32, b: i32| self.is_filled(a, b);
@@ -289,6 +358,7 @@ impl Sim<'_> {
             .count() as u64;
         self.run.messages.initial += 2 * if row > 0 { row } else { col };
         self.filled[k] = true;
+        self.paper_era_permissions(x, y, row > 0);
         self.run.order.push(Docking {
             cell: (x, y),
             attractor: by.map(|b| self.xy(b)),
