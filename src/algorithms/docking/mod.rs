@@ -283,6 +283,14 @@ pub fn emit_3d(goal: &plane_by_plane::Goal3, run: &plane_by_plane::Run3) -> (Sch
     s.meta
         .insert("rule1_violations".into(), run.rule1_violations.into());
     s.meta.insert("unfilled".into(), run.unfilled.into());
+    s.meta.insert(
+        "messages_paper_era".into(),
+        run.messages.total_paper().into(),
+    );
+    s.meta.insert(
+        "max_available".into(),
+        run.available.iter().copied().max().unwrap_or(0).into(),
+    );
     s.meta.insert("planes".into(), run.planes.into());
     s.meta.insert("components".into(), run.components.into());
     s.meta.insert("overhangs".into(), run.overhangs.into());

@@ -189,6 +189,10 @@ pub struct Docking3 {
     /// neighbour otherwise. `None` for the first module.
     pub attractor: Option<Cell>,
     pub time: u64,
+    /// The in-plane component it belongs to (numbered in run order), and
+    /// that component's docking positions available after it.
+    pub component: usize,
+    pub available_in_component: usize,
 }
 
 /// The outcome of a 3D run.
@@ -206,6 +210,10 @@ pub struct Run3 {
     pub components: usize,
     /// Components seeded at the end because nothing was below them.
     pub overhangs: usize,
+    /// After each docking: docking positions attracted and not yet docked,
+    /// over the components growing at that moment (a layer's, or one
+    /// overhang's).
+    pub available: Vec<usize>,
 }
 
 /// A component run by the 2D planner from its seed cell, attracted by the
@@ -222,14 +230,16 @@ fn grow_component(
     let (seed, below) = start;
     let g = Goal::from_cells(&format!("layer {z}"), comp).expect("a non-empty component");
     let r = planner::run(&g, seed, rng_seed, delays);
-    run.messages.initial += r.messages.initial;
-    run.messages.permission += r.messages.permission;
-    run.messages.sync += r.messages.sync;
+    run.messages.add(&r.messages);
     run.unfilled += r.unfilled;
     run.components += 1;
+    let component = run.components;
     r.order
         .iter()
-        .map(|d| Docking3 {
+        .zip(&r.available)
+        .map(|(d, &available_in_component)| Docking3 {
+            component,
+            available_in_component,
             cell: Cell::new(d.cell.0, d.cell.1, z),
             attractor: Some(match d.attractor {
                 Some((x, y)) => Cell::new(x, y, z),
@@ -299,7 +309,10 @@ pub fn run(goal: &Goal3, seed: u64, delays: &Delays) -> Run3 {
         // The layer's components grow concurrently: merge by time.
         dockings.sort_by_key(|d| d.time);
         t0 = dockings.last().map_or(t0, |d| d.time) + 1;
+        let mut open: rustc_hash::FxHashMap<usize, usize> = Default::default();
         for d in dockings {
+            open.insert(d.component, d.available_in_component);
+            run.available.push(open.values().sum());
             push(&mut run, &mut filled, d);
         }
     }
@@ -323,6 +336,7 @@ pub fn run(goal: &Goal3, seed: u64, delays: &Delays) -> Run3 {
                     let d = grow_component(z, &comp, start, t0, rng_seed, delays, &mut run);
                     t0 = d.last().map_or(t0, |d| d.time) + 1;
                     for d in d {
+                        run.available.push(d.available_in_component);
                         push(&mut run, &mut filled, d);
                     }
                 }
@@ -380,6 +394,9 @@ mod tests {
             assert_eq!(r.order.len(), g.len());
             assert_eq!((r.rule1_violations, r.unfilled), (0, 0));
             assert_eq!(r.planes, 5);
+            assert_eq!(r.available.len(), r.order.len());
+            assert_eq!(*r.available.last().unwrap(), 0);
+            assert!(r.available.iter().any(|&a| a > 1), "{:?}", r.available);
             // EndOfPlane: every docking of layer z comes after every one
             // of layer z − 1.
             let mut top = i32::MIN;

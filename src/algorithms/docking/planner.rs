@@ -107,6 +107,16 @@ pub struct Messages {
 }
 
 impl Messages {
+    /// Adds `o`'s counts to these.
+    pub fn add(&mut self, o: &Messages) {
+        self.initial += o.initial;
+        self.permission += o.permission;
+        self.sync += o.sync;
+        self.request += o.request;
+        self.reply += o.reply;
+        self.unasked += o.unasked;
+    }
+
     /// The total as the later code counts it (≈ 2.9n).
     pub fn total(&self) -> u64 {
         self.initial + self.permission + self.sync
