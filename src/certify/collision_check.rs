@@ -6,6 +6,7 @@ use super::report::{Severity, Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome};
 use crate::geometry::{Contact, ContactKind, GroundContact, SweepInput, SweepModel};
 use crate::lattice::Motion;
+use crate::lattice::config::ModuleId;
 
 /// Runs a sweep model on every step.
 pub struct CollisionCheck {
@@ -53,38 +54,19 @@ impl StepCheck for CollisionCheck {
     }
 }
 
-/// The violation (or warning) of one contact, with the cells it concerns:
-/// the mover's start and target cells (its link), then the other module's
-/// cell at the start of the step; the pivot's cell and the route are in the
-/// details.
-fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
-    let step = ctx.plan.step;
-    let config = ctx.world.config();
-    let motion = ctx
-        .plan
+/// The move of `mover` in this step, if it has one.
+fn motion_of<'a>(ctx: &'a StepContext<'_>, mover: ModuleId) -> Option<&'a Motion> {
+    ctx.plan
         .moves
         .iter()
-        .find(|m| m.module == c.mover)
-        .map(|m| &m.motion);
-    let (kind, what) = match c.kind {
-        ContactKind::Collision => (ViolationKind::Collision, "penetrates"),
-        ContactKind::SlidingContact => (ViolationKind::SlidingContact, "slides in contact with"),
-    };
-    let v = Violation::new(
-        kind,
-        step,
-        format!(
-            "module {} {what} module {} at s = {:.4} (depth {:.3e} d)",
-            c.mover, c.other, c.s, c.depth
-        ),
-    )
-    .modules([c.mover, c.other])
-    .cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten())
-    .cells(config.cell_of(c.other))
-    .detail("s", c.s)
-    .detail("depth", c.depth)
-    .detail("witness_mover", c.witness_mover.to_array())
-    .detail("witness_other", c.witness_other.to_array());
+        .find(|m| m.module == mover)
+        .map(|m| &m.motion)
+}
+
+/// `v` with the move's link cells first, and its pivot cell and route in
+/// the details.
+fn with_move(v: Violation, motion: Option<&Motion>) -> Violation {
+    let v = v.cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten());
     match motion {
         Some(Motion::Rotate { pivot, route, .. }) => {
             v.detail("pivot_cell", pivot).detail("route", route)
@@ -96,15 +78,35 @@ fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
     }
 }
 
+/// The violation (or warning) of one contact, with the cells it concerns:
+/// the mover's start and target cells (its link), then the other module's
+/// cell at the start of the step; the pivot's cell and the route are in the
+/// details.
+fn contact_violation(c: &Contact, ctx: &StepContext<'_>) -> Violation {
+    let (kind, what) = match c.kind {
+        ContactKind::Collision => (ViolationKind::Collision, "penetrates"),
+        ContactKind::SlidingContact => (ViolationKind::SlidingContact, "slides in contact with"),
+    };
+    let v = Violation::new(
+        kind,
+        ctx.plan.step,
+        format!(
+            "module {} {what} module {} at s = {:.4} (depth {:.3e} d)",
+            c.mover, c.other, c.s, c.depth
+        ),
+    )
+    .modules([c.mover, c.other]);
+    with_move(v, motion_of(ctx, c.mover))
+        .cells(ctx.world.config().cell_of(c.other))
+        .detail("s", c.s)
+        .detail("depth", c.depth)
+        .detail("witness_mover", c.witness_mover.to_array())
+        .detail("witness_other", c.witness_other.to_array())
+}
+
 /// The violation of a mover digging into the floor: its link's cells and
 /// its pivot's cell, the floor's height and the deepest point.
 fn ground_violation(c: &GroundContact, ctx: &StepContext<'_>) -> Violation {
-    let motion = ctx
-        .plan
-        .moves
-        .iter()
-        .find(|m| m.module == c.mover)
-        .map(|m| &m.motion);
     let v = Violation::new(
         ViolationKind::GroundCollision,
         ctx.plan.step,
@@ -113,16 +115,10 @@ fn ground_violation(c: &GroundContact, ctx: &StepContext<'_>) -> Violation {
             c.mover, c.depth, c.floor, c.s
         ),
     )
-    .modules([c.mover])
-    .cells(motion.map(|m| [m.from(), m.to()]).into_iter().flatten())
-    .detail("s", c.s)
-    .detail("depth", c.depth)
-    .detail("floor_z", c.floor)
-    .detail("witness_mover", c.witness.to_array());
-    match motion {
-        Some(Motion::Rotate { pivot, route, .. }) => {
-            v.detail("pivot_cell", pivot).detail("route", route)
-        }
-        _ => v,
-    }
+    .modules([c.mover]);
+    with_move(v, motion_of(ctx, c.mover))
+        .detail("s", c.s)
+        .detail("depth", c.depth)
+        .detail("floor_z", c.floor)
+        .detail("witness_mover", c.witness.to_array())
 }

@@ -162,6 +162,29 @@ pub fn fig10(rows: &[MessageRow], seeds: u64, path: &Path) -> Result<(), Error> 
                     + PathElement::new(outline(k, 5), style)
             });
         }
+        // The same runs counted as the authors' paper-era code counts
+        // (filled dots), with one fit over every shape.
+        let era: Vec<(f64, f64)> = rows
+            .iter()
+            .map(|r| (r.modules as f64, r.messages_paper_era))
+            .collect();
+        let era_label = match crate::study::docking::linear_fit(&era) {
+            Some(f) => format!(
+                "filled: counted as the Nov. 2017 code (fit {:.2}n)",
+                f.slope
+            ),
+            None => "filled: counted as the Nov. 2017 code".to_string(),
+        };
+        c.draw_series(rows.iter().map(|r| {
+            Circle::new(
+                (r.modules as f64, r.messages_paper_era),
+                4,
+                colour(&r.shape).filled(),
+            )
+        }))
+        .map_err(draw_err)?
+        .label(era_label)
+        .legend(|(x, y)| Circle::new((x + 9, y), 4, BLACK.filled()));
         crate::render::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(draw_err)?;
         Ok(())

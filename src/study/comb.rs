@@ -86,28 +86,10 @@ pub fn run(
 pub fn loglog_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     let p: Vec<(f64, f64)> = points
         .iter()
-        .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
         .map(|(x, y)| (x.ln(), y.ln()))
         .collect();
-    if p.len() < 2 {
-        return None;
-    }
-    let n = p.len() as f64;
-    let mx = p.iter().map(|q| q.0).sum::<f64>() / n;
-    let my = p.iter().map(|q| q.1).sum::<f64>() / n;
-    let sxx: f64 = p.iter().map(|q| (q.0 - mx).powi(2)).sum();
-    let sxy: f64 = p.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
-    let syy: f64 = p.iter().map(|q| (q.1 - my).powi(2)).sum();
-    if sxx == 0.0 {
-        return None;
-    }
-    let b = sxy / sxx;
-    let r2 = if syy == 0.0 {
-        1.0
-    } else {
-        sxy * sxy / (sxx * syy)
-    };
-    Some((b, r2))
+    super::docking::linear_fit(&p).map(|f| (f.slope, f.r2))
 }
 
 #[cfg(test)]

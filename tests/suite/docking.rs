@@ -301,45 +301,14 @@ fn bad_goals_are_refused_with_exit_2_naming_the_file() {
             "no cell for the seed",
         ),
     ];
-    for (file, csg, extra, want) in cases {
-        std::fs::write(dir.join(file), csg).unwrap();
+    // Generates `file` with `algorithm` and expects exit 2 naming the file
+    // and `want`.
+    let refused = |algorithm: &str, file: &str, extra: &str, want: &str| {
         let s = scenario(
             &dir,
-            &format!("{file}.toml"),
+            &format!("{file}-{algorithm}.toml"),
             &format!(
-                "name = \"bad\"\nalgorithm = \"docking\"\n[parameters]\nshape = \"{file}\"\n{extra}"
-            ),
-        );
-        let out = bin()
-            .args(["generate"])
-            .arg(&s)
-            .arg("-o")
-            .arg(dir.join("out.json"))
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
-        assert!(err.contains(file), "{file}: {err}");
-        assert!(err.contains(want), "{file}: {err}");
-    }
-    // The same for the 3D generator (no slice: a goal with no cell is a
-    // solid too small to hold a cell centre).
-    let cases3d = [
-        ("two.csg", "disconnected"),
-        ("far.csg", "off the lattice"),
-        ("speck.csg", "no cell"),
-    ];
-    std::fs::write(
-        dir.join("speck.csg"),
-        "translate([0.5, 0.3, 0.3]) cube([0.01, 0.01, 0.01], center = true);",
-    )
-    .unwrap();
-    for (file, want) in cases3d {
-        let s = scenario(
-            &dir,
-            &format!("{file}-3d.toml"),
-            &format!(
-                "name = \"bad\"\nalgorithm = \"docking-3d\"\n[parameters]\nshape = \"{file}\"\n"
+                "name = \"bad\"\nalgorithm = \"{algorithm}\"\n[parameters]\nshape = \"{file}\"\n{extra}"
             ),
         );
         let out = bin()
@@ -353,6 +322,24 @@ fn bad_goals_are_refused_with_exit_2_naming_the_file() {
         assert_eq!(out.status.code(), Some(2), "{file}: {err}");
         assert!(err.contains(file) && err.contains(want), "{file}: {err}");
         assert!(!err.contains("panicked"), "{err}");
+    };
+    for (file, csg, extra, want) in cases {
+        std::fs::write(dir.join(file), csg).unwrap();
+        refused("docking", file, extra, want);
+    }
+    // The same for the 3D generator (no slice: a goal with no cell is a
+    // solid too small to hold a cell centre).
+    std::fs::write(
+        dir.join("speck.csg"),
+        "translate([0.5, 0.3, 0.3]) cube([0.01, 0.01, 0.01], center = true);",
+    )
+    .unwrap();
+    for (file, want) in [
+        ("two.csg", "disconnected"),
+        ("far.csg", "off the lattice"),
+        ("speck.csg", "no cell"),
+    ] {
+        refused("docking-3d", file, "", want);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
