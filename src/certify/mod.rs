@@ -177,8 +177,16 @@ pub fn checks_for(
     }
     if let Some(path) = model_path(schedule, opts) {
         let model = crate::mechanics::Model::load(&path)?;
-        let check = LoadCheck::new(&model, schedule.spacing.metres(), true)
-            .map_err(|e| e.in_file(&path))?;
+        // The model loaded; only its rescaling to the schedule's spacing
+        // fails, so the error is the schedule's (its file is the caller's
+        // to add) and names the model in its message.
+        let check = LoadCheck::new(&model, schedule.spacing.metres(), true).map_err(|e| {
+            InputError::new(format!(
+                "the schedule's spacing does not fit the model {}: {}",
+                path.display(),
+                e.message
+            ))
+        })?;
         checks.push(Box::new(check));
     }
     Ok(checks)

@@ -282,3 +282,32 @@ fn model_fields_out_of_their_range_are_refused_naming_the_field() {
         assert!(err.contains(field), "{tag}: {err}");
     }
 }
+
+#[test]
+fn a_spacing_the_model_cannot_scale_to_is_refused_naming_the_schedule_and_the_model() {
+    // The model loads; only its rescaling to a 1e300 m spacing overflows
+    // (the mass goes to infinity). The schedule is at fault: exit 2,
+    // naming the schedule's file, with the model in the message.
+    let p = scratch("huge-spacing.json");
+    walk_with_obstacle(&p, false);
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    v["spacing"] = serde_json::json!({"value": 1e300, "unit": "m"});
+    std::fs::write(&p, v.to_string()).unwrap();
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let o = bin()
+        .arg("certify")
+        .arg(&p)
+        .arg("--model")
+        .arg(&model)
+        .arg("--no-progress")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("huge-spacing.json"), "{err}");
+    assert!(
+        err.contains("catom-3.6mm.toml") && err.contains("spacing"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}

@@ -230,15 +230,18 @@ fn edited_model(path: &str, edits: &[(prop::sample::Index, usize, usize)]) -> St
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
-    /// The CSG parser and the solid it builds: an edited sandcastle is
-    /// refused or gives a solid whose bounds and membership can be asked.
+    /// The CSG parser and the solid it builds: an edited sandcastle, or an
+    /// edited mug (rotate, scale), is refused or gives a solid whose
+    /// bounds and membership can be asked.
     #[test]
     fn edited_csg_files_are_refused_or_parsed_never_a_panic(
         edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+        mug in any::<bool>(),
     ) {
         use reconfcheck::algorithms::scaffold::csg::CsgShape;
         use reconfcheck::algorithms::scaffold::shape::{Shape as _, Skew};
-        let edited = edited_model("models/shapes/sandcastle.csg", &edits);
+        let file = if mug { "models/docking/mug.csg" } else { "models/shapes/sandcastle.csg" };
+        let edited = edited_model(file, &edits);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             CsgShape::parse("edited", &edited).map(|s| {
                 let (lo, hi) = s.skew_bounds();
