@@ -8,6 +8,7 @@
 //! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test suite fuzz::` searches longer.
 
 use proptest::prelude::*;
+use proptest::test_runner::FileFailurePersistence;
 use reconfcheck::algorithms::random_walk::{WalkParams, walk};
 use reconfcheck::certify::{Options, certify};
 use reconfcheck::schedule::Schedule;
@@ -121,8 +122,23 @@ fn mutate(mut v: Value, what: usize, pick: prop::sample::Index, with: usize) -> 
     v
 }
 
+/// `cases` cases, replaying first the failures saved in
+/// `tests/suite/fuzz.proptest-regressions` (cargo runs integration tests
+/// from the package root). Proptest's default path, derived from the
+/// source file, no longer finds that file since the tests became one
+/// binary, and would save new failures elsewhere.
+fn config(cases: u32) -> ProptestConfig {
+    ProptestConfig {
+        cases,
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
+            "tests/suite/fuzz.proptest-regressions",
+        ))),
+        ..ProptestConfig::default()
+    }
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(config(256))]
 
     #[test]
     fn edited_schedules_are_refused_or_certified_never_a_panic(
@@ -228,7 +244,7 @@ fn edited_model(path: &str, edits: &[(prop::sample::Index, usize, usize)]) -> St
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(config(256))]
 
     /// The CSG parser and the solid it builds: an edited sandcastle, or an
     /// edited mug (rotate, scale), is refused or gives a solid whose
@@ -328,7 +344,7 @@ fn parameter_values() -> Vec<toml::Value> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(config(256))]
 
     /// Every generator with an edited parameter (a value replaced by one of
     /// another kind or an extreme one, or deleted): refused as input naming
@@ -392,7 +408,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(config(256))]
 
     /// VisibleSim configurations (issue #15): an edited bundled
     /// `rolls.xml` is refused naming the file, or imports, exports and
