@@ -77,9 +77,10 @@ impl StepCheck for DockingCheck {
             let ground = w.ground();
             let bounds = bounds_of(config);
             let verdict = judge(lattice, config, ground, &approach, self.epsilon);
-            let reachable = !verdict.is_clear()
-                || origin_reachable(lattice, config, ground, bounds, approach.from);
-            if verdict.is_clear() && reachable && !plan.moving.contains(&d.pivot) {
+            // Only a clear approach needs the search: a blocked one fails anyway.
+            let enclosed = verdict.is_clear()
+                && !origin_reachable(lattice, config, ground, bounds, approach.from);
+            if verdict.is_clear() && !enclosed && !plan.moving.contains(&d.pivot) {
                 continue;
             }
             let others = clear_approaches(lattice, config, ground, bounds, cell, self.epsilon);
@@ -92,7 +93,7 @@ impl StepCheck for DockingCheck {
             if let Some(depth) = verdict.below_floor {
                 why.push(format!("its sweep dips {depth:.3e} d below the floor"));
             }
-            if !reachable {
+            if enclosed {
                 cells.push(approach.from);
                 why.push(format!(
                     "its origin {} is enclosed: no free path reaches it from outside the structure",

@@ -243,18 +243,24 @@ pub fn clear_approaches(
 
 /// The bounding box of the occupied cells (an empty box for no cells).
 pub fn bounds_of(config: &Configuration) -> (Cell, Cell) {
-    config.iter().fold(
-        (
-            Cell::new(i32::MAX, i32::MAX, i32::MAX),
-            Cell::new(i32::MIN, i32::MIN, i32::MIN),
-        ),
-        |(lo, hi), (_, c)| {
-            (
-                Cell::new(lo.x.min(c.x), lo.y.min(c.y), lo.z.min(c.z)),
-                Cell::new(hi.x.max(c.x), hi.y.max(c.y), hi.z.max(c.z)),
-            )
-        },
+    let empty = (
+        Cell::new(i32::MAX, i32::MAX, i32::MAX),
+        Cell::new(i32::MIN, i32::MIN, i32::MIN),
+    );
+    config.iter().fold(empty, |b, (_, c)| grow_bounds(b, c))
+}
+
+/// The bounding box `b` grown to hold `c`.
+pub fn grow_bounds(b: (Cell, Cell), c: Cell) -> (Cell, Cell) {
+    (
+        Cell::new(b.0.x.min(c.x), b.0.y.min(c.y), b.0.z.min(c.z)),
+        Cell::new(b.1.x.max(c.x), b.1.y.max(c.y), b.1.z.max(c.z)),
     )
+}
+
+/// Whether `c` holds no module and is not inside the ground.
+fn is_open(lattice: &dyn Lattice, config: &Configuration, ground: Option<Ground>, c: Cell) -> bool {
+    config.is_free(c) && !ground.is_some_and(|g| g.is_ground_cell(lattice, c))
 }
 
 /// Whether the motion rules (the compiled tables, not an exact sweep)
@@ -269,7 +275,7 @@ pub fn planned_clear(
     approach: &Approach,
     strict: bool,
 ) -> bool {
-    let free = |c: Cell| config.is_free(c) && !ground.is_some_and(|g| g.is_ground_cell(lattice, c));
+    let free = |c: Cell| is_open(lattice, config, ground, c);
     if !free(approach.from) || config.is_free(approach.pivot) {
         return false;
     }
@@ -340,7 +346,7 @@ pub fn origin_reachable(
         .unwrap_or(0)
         .max(0)
     };
-    let open = |c: Cell| config.is_free(c) && !ground.is_some_and(|g| g.is_ground_cell(lattice, c));
+    let open = |c: Cell| is_open(lattice, config, ground, c);
     if !open(origin) {
         return false;
     }

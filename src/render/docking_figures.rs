@@ -168,7 +168,7 @@ pub fn fig10(rows: &[MessageRow], seeds: u64, path: &Path) -> Result<(), Error> 
             .iter()
             .map(|r| (r.modules as f64, r.messages_paper_era))
             .collect();
-        let era_label = match crate::study::docking::linear_fit(&era) {
+        let era_label = match crate::study::fit::linear_fit(&era) {
             Some(f) => format!(
                 "filled: counted as the Nov. 2017 code (fit {:.2}n)",
                 f.slope

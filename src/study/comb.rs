@@ -89,7 +89,7 @@ pub fn loglog_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
         .filter(|(x, y)| *x > 0.0 && *y > 0.0)
         .map(|(x, y)| (x.ln(), y.ln()))
         .collect();
-    super::docking::linear_fit(&p).map(|f| (f.slope, f.r2))
+    super::fit::linear_fit(&p).map(|f| (f.slope, f.r2))
 }
 
 #[cfg(test)]

@@ -6,5 +6,6 @@ pub mod b_study;
 pub mod comb;
 pub mod density;
 pub mod docking;
+pub mod fit;
 pub mod scaffold_figures;
 pub mod synthetic;

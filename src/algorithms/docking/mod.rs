@@ -23,7 +23,7 @@ pub mod rule1;
 use super::{Generator, parameters};
 use crate::error::InputError;
 use crate::geometry::Tolerance;
-use crate::geometry::docking::{Approach, candidates, clear_approaches, judge};
+use crate::geometry::docking::{Approach, candidates, clear_approaches, grow_bounds, judge};
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Configuration, LatticeKind, Motion, SquareLattice};
 use crate::scenario::Scenario;
@@ -161,7 +161,7 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         config
             .insert(id, cell)
             .expect("the planner docks a cell once");
-        bounds = grow(bounds, cell);
+        bounds = grow_bounds(bounds, cell);
     }
     s.meta.insert("algorithm".into(), "docking".into());
     s.meta.insert("goal".into(), goal.name.clone().into());
@@ -172,14 +172,6 @@ fn emit(goal: &Goal, run: &Run) -> (Schedule, usize) {
         .insert("rule1_violations".into(), run.rule1_violations.into());
     s.meta.insert("unfilled".into(), run.unfilled.into());
     (s, without)
-}
-
-/// The bounding box `b` grown to hold `c`.
-pub fn grow(b: (Cell, Cell), c: Cell) -> (Cell, Cell) {
-    (
-        Cell::new(b.0.x.min(c.x), b.0.y.min(c.y), b.0.z.min(c.z)),
-        Cell::new(b.1.x.max(c.x), b.1.y.max(c.y), b.1.z.max(c.z)),
-    )
 }
 
 /// Scenario parameters of `docking-3d`.
@@ -273,7 +265,7 @@ pub fn emit_3d(goal: &plane_by_plane::Goal3, run: &plane_by_plane::Run3) -> (Sch
             }],
         });
         config.insert(id, d.cell).expect("one docking per cell");
-        bounds = grow(bounds, d.cell);
+        bounds = grow_bounds(bounds, d.cell);
     }
     s.meta.insert("algorithm".into(), "docking-3d".into());
     s.meta.insert("goal".into(), goal.name.clone().into());

@@ -122,7 +122,8 @@ impl Messages {
         self.initial + self.permission + self.sync
     }
 
-    /// The total as the paper-era code counts it (≈ 5n, the paper's).
+    /// The total as the paper-era code counts it: ≈ 5n on the authors'
+    /// own docking order (the paper's figure), ≈ 4.2n on this planner's.
     pub fn total_paper(&self) -> u64 {
         self.initial + self.request + self.reply + self.unasked + self.sync
     }
