@@ -430,11 +430,13 @@ fn branches_cut_by_a_concavity_grow_partially_and_feed_no_tile() {
 }
 
 /// Seed 000 Eq. (6): T = 16(b − 1)(h − 1) = 80 steps per tile layer at
-/// b = 6. The paper's protocol takes 67 / 164 / 266 steps for h = 2 / 3 /
-/// 4 (Eq. 6: 80 / 160 / 240), against 90 / 203 / 325 for the safe one;
-/// the whole table is in docs/scaffold.md.
+/// b = 6. The paper's protocol (the authors' tile queue, supports
+/// together) takes 61 / 146 / 233 / 324 steps for h = 2 … 5 (Eq. 6: 80 /
+/// 160 / 240 / 320): within ±10 % from h = 3 on; h = 2 is 24 % faster,
+/// its one layer fed straight from the sandbox. The safe protocol is
+/// slower on every h; the whole table is in docs/scaffold.md.
 #[test]
-fn the_papers_protocol_is_faster_than_the_safe_one_and_near_equation_6() {
+fn the_papers_protocol_is_within_ten_percent_of_equation_6_from_h_3_and_faster_than_the_safe_one() {
     use reconfcheck::algorithms::scaffold::paper::Protocol;
     let steps = |h, p| {
         scaffold_schedule_with(&ShapeSpec::Pyramid { h }, 6, p)
@@ -442,17 +444,14 @@ fn the_papers_protocol_is_faster_than_the_safe_one_and_near_equation_6() {
             .steps
             .len()
     };
-    let paper: Vec<usize> = (2..=4).map(|h| steps(h, Protocol::Paper)).collect();
-    assert_eq!(paper, [67, 164, 266]);
-    for (h, &t) in (2..=4u32).zip(&paper) {
+    let paper: Vec<usize> = (2..=5).map(|h| steps(h, Protocol::Paper)).collect();
+    assert_eq!(paper, [61, 146, 233, 324]);
+    for (h, &t) in (2..=5u32).zip(&paper) {
         assert!(t < steps(h, Protocol::Safe), "h = {h}");
+        let eq6 = 16.0 * 5.0 * (h - 1) as f64;
+        let off = t as f64 / eq6 - 1.0;
+        assert_eq!(off.abs() <= 0.10, h >= 3, "h = {h}: {t} steps, Eq. 6 {eq6}");
     }
-    let eq6 = 80.0 * 2.0;
-    assert!(
-        (paper[1] as f64 / eq6 - 1.0).abs() <= 0.10,
-        "h = 3: {}",
-        paper[1]
-    );
 }
 
 /// Item 3 of the issue: the paper's protocol, replayed with the exact

@@ -172,7 +172,13 @@ pub fn schedule_for(
     rules: &dyn MotionRules,
     protocol: Protocol,
 ) -> Result<Schedule, InputError> {
-    let tree = polytree::Polytree::build(s);
+    let tree = polytree::Polytree::build_with(
+        s,
+        match protocol {
+            Protocol::Safe => polytree::Supports::OneAfterAnother,
+            Protocol::Paper => polytree::Supports::Together,
+        },
+    );
     let n = s.components.len();
     let mut succ = vec![Vec::new(); n];
     let mut missing: Vec<usize> = tree.preds.iter().map(Vec::len).collect();

@@ -16,12 +16,34 @@
 //!   between two opposite modules (bridging constraint);
 //! * the rest of a horizontal branch grows outwards after all supports and
 //!   first modules;
-//! * upward branches start after every horizontal branch of the tile is
-//!   complete (rule 3) and grow outwards.
+//! * rule 3 ("horizontal branches must be built before all vertical
+//!   branches are grown") as the authors' implementation reads it: their
+//!   per-tile construction queue (VisibleSim 1aa66fe4, b = 6) starts Z and
+//!   RevZ after the third module of X and Y, and LZ and RZ after the
+//!   horizontal branches and the fourth modules of Z and RevZ; upward
+//!   branches grow outwards. Read strictly (every upward branch after
+//!   every horizontal tip) it made the paper protocol 6–8 % slower on
+//!   pyramids h ≥ 4 (docs/scaffold.md);
+//! * the supports go in one after another (safe protocol) or together
+//!   (paper protocol, as the authors' queue feeds them), see [`Supports`].
 
 use super::scaffold::{Dir, Scaffold};
 use super::shape::Skew;
 use std::collections::BTreeMap;
+
+/// When a tile's supports may go in (§3.2.3 rule 2 leaves it open).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Supports {
+    /// One after another, after the root and the first horizontal
+    /// modules: the safe protocol's order (supports arriving together at
+    /// neighbouring entry cells can pinch a departing module, a
+    /// `sliding_contact` the exact sweep reports).
+    OneAfterAnother,
+    /// All together once the root and the first horizontal modules are
+    /// in, as the authors' tile queue feeds them (two at a time, from
+    /// different entry points): the paper protocol's order.
+    Together,
+}
 
 /// Precedences of a scaffold's components.
 #[derive(Clone, Debug)]
@@ -35,6 +57,11 @@ pub struct Polytree {
 
 impl Polytree {
     pub fn build(s: &Scaffold) -> Polytree {
+        Polytree::build_with(s, Supports::OneAfterAnother)
+    }
+
+    /// [`Polytree::build`] with the supports ordered as `supports` says.
+    pub fn build_with(s: &Scaffold, supports: Supports) -> Polytree {
         let b = s.b;
         let mut parents = BTreeMap::new();
         let mut preds = vec![Vec::new(); s.components.len()];
@@ -95,9 +122,14 @@ impl Polytree {
                 early.push(tip);
                 lone_prev = Some(tip);
             }
+            let before_supports = early.clone();
             for &u in &t.ingoing_up {
                 let si = idx(r.offset(u.mirror().support_offset())).expect("support exists");
-                preds[si] = early.clone();
+                preds[si] = if supports == Supports::Together {
+                    before_supports.clone()
+                } else {
+                    early.clone()
+                };
                 early.push(si);
             }
             for &(d, len) in t.branches.iter().filter(|(d, _)| !d.is_upward()) {
@@ -114,12 +146,44 @@ impl Polytree {
                 .copied()
                 .filter(|b| b.0.is_upward() && !unsupported.contains(b))
                 .collect();
+            // Where each upward branch starts (rule 3, read as the
+            // authors' tile queue reads it): Z and RevZ once the third
+            // module of each X / Y branch is in (or its tip, if shorter),
+            // LZ and RZ once the horizontal branches are complete and the
+            // fourth modules of Z and RevZ are in. A tile that grows Opp
+            // branches starts every upward branch after its horizontal
+            // tips.
+            let module = |d: Dir, len: u32, m: u32| {
+                idx(r.offset(d.step().scale(m.min(len) as i32))).expect("branch module")
+            };
+            let has_opp = t
+                .branches
+                .iter()
+                .any(|&(d, len)| matches!(d, Dir::OppX | Dir::OppY) && len > 1);
             for &(d, len) in &ups {
+                let start: Vec<usize> = match d {
+                    Dir::Z | Dir::RevZ if !has_opp => t
+                        .branches
+                        .iter()
+                        .filter(|(h, _)| !h.is_upward())
+                        .map(|&(h, hl)| module(h, hl, 3))
+                        .collect(),
+                    Dir::LZ | Dir::RZ => {
+                        let mut p = horizontal_tips.clone();
+                        p.extend(
+                            ups.iter()
+                                .filter(|(u, _)| matches!(u, Dir::Z | Dir::RevZ))
+                                .map(|&(u, ul)| module(u, ul, 4)),
+                        );
+                        p
+                    }
+                    _ => horizontal_tips.clone(),
+                };
                 for m in 1..=len as i32 {
                     let c = idx(r.offset(d.step().scale(m))).expect("branch module");
                     preds[c] = if m == 1 {
                         let mut p = early.clone();
-                        p.extend(&horizontal_tips);
+                        p.extend(&start);
                         p
                     } else {
                         vec![idx(r.offset(d.step().scale(m - 1))).expect("previous")]
@@ -220,6 +284,52 @@ mod tests {
         // A layer-1 root waits for its 4 ingoing upward branch tips (and none horizontal at the seed corner).
         let up = s.index[&Skew::new(0, 0, 6)];
         assert_eq!(p.preds[up].len(), 4);
+    }
+
+    #[test]
+    fn upward_branches_start_as_the_authors_tile_queue_feeds_them() {
+        // Tile (6, 6, 0) of the 3-pyramid grows X, Y, Z, RevZ, LZ and RZ.
+        let s = pyramid(3);
+        let p = Polytree::build(&s);
+        let r = Skew::new(6, 6, 0);
+        let at = |d: Dir, m: i32| s.index[&r.offset(d.step().scale(m))];
+        let z1 = &p.preds[at(Dir::Z, 1)];
+        assert!(z1.contains(&at(Dir::X, 3)) && z1.contains(&at(Dir::Y, 3)));
+        assert!(
+            !z1.contains(&at(Dir::X, 5)),
+            "Z waits only for X3, not X's tip"
+        );
+        let lz1 = &p.preds[at(Dir::LZ, 1)];
+        for need in [
+            at(Dir::X, 5),
+            at(Dir::Y, 5),
+            at(Dir::Z, 4),
+            at(Dir::RevZ, 4),
+        ] {
+            assert!(lz1.contains(&need), "{:?}", s.components[need].part);
+        }
+        assert_eq!(p.preds[at(Dir::Z, 2)], vec![at(Dir::Z, 1)]);
+    }
+
+    #[test]
+    fn supports_go_in_together_or_one_after_another() {
+        let s = pyramid(3);
+        let r = Skew::new(6, 6, 6);
+        let supports: Vec<usize> = Dir::UPWARD
+            .iter()
+            .map(|u| s.index[&r.offset(u.support_offset())])
+            .collect();
+        let waits_for_a_support = |p: &Polytree| {
+            supports
+                .iter()
+                .filter(|&&i| p.preds[i].iter().any(|q| supports.contains(q)))
+                .count()
+        };
+        assert_eq!(
+            waits_for_a_support(&Polytree::build_with(&s, Supports::Together)),
+            0
+        );
+        assert_eq!(waits_for_a_support(&Polytree::build(&s)), 3);
     }
 
     #[test]
