@@ -23,6 +23,10 @@ pub struct Args {
     /// Certify the expanded schedules up to this many meta-modules.
     #[arg(long, default_value_t = 4096)]
     certify_up_to: usize,
+    /// Draw the scaling plot (log–log, fits, naive baseline) to this PNG
+    /// (or SVG) file.
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
     /// Also write the rows as JSON.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -86,16 +90,16 @@ pub fn run(a: Args) -> Result<u8, Error> {
                 r.certified.map_or("-".into(), |c| c.to_string()),
             );
         }
-        let fit = |f: &dyn Fn(&study::Row) -> usize| {
-            let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.atoms as f64, f(r) as f64)).collect();
-            study::loglog_fit(&pts).map_or("-".to_string(), |(b, r2)| {
-                format!("slope {b:.3}, R² {r2:.3}")
-            })
-        };
-        println!("parallel steps vs n: {}", fit(&|r| r.steps));
-        println!("atom operations vs n: {}", fit(&|r| r.operations));
-        println!("naive steps vs n: {}", fit(&|r| r.baseline_steps));
-        println!("naive operations vs n: {}", fit(&|r| r.baseline_operations));
+        for (name, pts) in study::series(&rows) {
+            let fit = study::loglog_fit(&pts).map_or("-".to_string(), |f| {
+                format!("slope {:.3}, R² {:.3}", f.slope, f.r2)
+            });
+            println!("{name} vs n: {fit}");
+        }
+        if let Some(p) = &a.plot {
+            reconfcheck::render::comb_figures::scaling(&rows, rest, p)?;
+            println!("wrote {}", p.display());
+        }
         all.push((rest, rows));
     }
     if let Some(p) = &a.json {

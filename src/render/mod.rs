@@ -11,6 +11,7 @@ use std::sync::{Arc, OnceLock};
 
 mod b_study;
 mod catom;
+pub mod comb_figures;
 pub mod density;
 pub mod docking_figures;
 mod loadmap;

@@ -8,6 +8,7 @@ use crate::certify::{self, Options};
 use crate::error::InputError;
 use crate::geometry::atom_expand::{expand, slide_library};
 use crate::lattice::AtomRest;
+use crate::study::fit::LinearFit;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
@@ -81,15 +82,31 @@ pub fn run(
     Ok(rows)
 }
 
-/// Least-squares fit of `log y = a + b·log x`: the slope `b` and R².
-/// Points with a non-positive coordinate are left out.
-pub fn loglog_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+/// Least-squares fit of `ln y = a + b·ln x` (slope `b`, intercept `a`,
+/// R² in log space): the power law `y = eᵃ·xᵇ`. Points with a
+/// non-positive coordinate are left out.
+pub fn loglog_fit(points: &[(f64, f64)]) -> Option<LinearFit> {
     let p: Vec<(f64, f64)> = points
         .iter()
         .filter(|(x, y)| *x > 0.0 && *y > 0.0)
         .map(|(x, y)| (x.ln(), y.ln()))
         .collect();
-    super::fit::linear_fit(&p).map(|f| (f.slope, f.r2))
+    super::fit::linear_fit(&p)
+}
+
+/// The study's four measured series against atoms n, in the order the
+/// table prints them: parallel steps, atom operations, and the naive
+/// baseline's steps and operations.
+pub fn series(rows: &[Row]) -> [(&'static str, Vec<(f64, f64)>); 4] {
+    let pts = |f: fn(&Row) -> usize| -> Vec<(f64, f64)> {
+        rows.iter().map(|r| (r.atoms as f64, f(r) as f64)).collect()
+    };
+    [
+        ("parallel steps", pts(|r| r.steps)),
+        ("atom operations", pts(|r| r.operations)),
+        ("naive steps", pts(|r| r.baseline_steps)),
+        ("naive operations", pts(|r| r.baseline_operations)),
+    ]
 }
 
 #[cfg(test)]
@@ -103,9 +120,10 @@ mod tests {
             .map(|&x: &f64| (x, 3.0 * x.powf(1.5)))
             .chain([(0.0, 1.0), (f64::NAN, 2.0)])
             .collect();
-        let (b, r2) = loglog_fit(&pts).unwrap();
-        assert!((b - 1.5).abs() < 1e-12);
-        assert!((r2 - 1.0).abs() < 1e-12);
+        let f = loglog_fit(&pts).unwrap();
+        assert!((f.slope - 1.5).abs() < 1e-12);
+        assert!((f.intercept - 3f64.ln()).abs() < 1e-12);
+        assert!((f.r2 - 1.0).abs() < 1e-12);
         assert!(loglog_fit(&[(1.0, 1.0)]).is_none());
     }
 }
