@@ -200,76 +200,86 @@ pub fn plan(
                 destinations.push((d, *e));
             }
         }
-        // 3. Streamlines by max-flow with unit vertex capacities.
-        let streamlines = streamlines(&state, &sources, &destinations);
-        if streamlines.is_empty() {
-            let m = empty_sorted
-                .first()
-                .or(extra.first())
-                .copied()
-                .unwrap_or(gc);
-            return Err(PlanError::Unreachable(m));
-        }
-        // 4. Transport.
+        // 3. Streamlines by max-flow with unit vertex capacities, and
+        // 4. transport. A streamline whose catoms find no rotation path is
+        // deferred: its source is left out and the flow recomputed, the
+        // streamlines already planned kept (a source can be walled in by
+        // a neighbour that a later iteration dismantles first).
         let first_step = out.steps.len();
         let before = scene.clone();
         let mut lanes: Vec<Vec<(Cell, Hop)>> = Vec::new();
         let mut goals: Vec<Meta> = Vec::new();
-        for line in &streamlines {
-            let (src, dst) = (line[0], *line.last().expect("a streamline has an end"));
-            let goal_meta = destinations
+        let mut planned: Vec<Vec<Meta>> = Vec::new();
+        let mut deferred: FxHashSet<Meta> = FxHashSet::default();
+        let mut stuck = None;
+        loop {
+            let open: Vec<Meta> = sources
                 .iter()
-                .find(|(d, _)| *d == dst)
-                .map(|(_, e)| *e)
-                .expect("a destination has its goal cell");
-            let from = src.sparse_cells();
-            let targets = goal_meta.sparse_cells();
-            // Inside the streamline's boxes first, then with one cell of
-            // margin; strictly (no sliding contact) first in each.
-            let mut found = None;
-            let mut last = targets[0];
-            'tries: for margin in [0, 1] {
-                let mut reg: FxHashSet<Cell> = FxHashSet::default();
-                for m in line.iter().chain([&goal_meta]) {
-                    for c in region(*m) {
-                        for dx in -margin..=margin {
-                            for dy in -margin..=margin {
-                                reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
+                .filter(|m| !deferred.contains(m) && state.contains_key(m))
+                .copied()
+                .collect();
+            let open_dest: Vec<(Meta, Meta)> = destinations
+                .iter()
+                .filter(|(_, e)| !state.contains_key(e))
+                .copied()
+                .collect();
+            let lines = streamlines(&state, &open, &open_dest);
+            if lines.is_empty() {
+                break;
+            }
+            let mut progress = false;
+            for line in lines {
+                let (src, dst) = (line[0], *line.last().expect("a streamline has an end"));
+                let goal_meta = open_dest
+                    .iter()
+                    .find(|(d, _)| *d == dst)
+                    .map(|(_, e)| *e)
+                    .expect("a destination has its goal cell");
+                match transport(&scene, &line, goal_meta) {
+                    Ok(paths) => {
+                        // The next streamline plans against this one's end state.
+                        for p in &paths {
+                            let (a, b) = (p[0].from, p[p.len() - 1].to);
+                            let id = scene.at.remove(&a).expect("mover in place");
+                            scene.insert(id, b);
+                        }
+                        let mut lane = Vec::new();
+                        for p in paths {
+                            let start = p[0].from;
+                            for h in p {
+                                lane.push((start, h));
                             }
                         }
+                        lanes.push(lane);
+                        goals.push(goal_meta);
+                        state.remove(&src);
+                        state.insert(goal_meta, State::Sparse);
+                        planned.push(line);
+                        progress = true;
+                    }
+                    Err(c) => {
+                        stuck.get_or_insert((goal_meta, c));
+                        deferred.insert(src);
                     }
                 }
-                for strict in [true, false] {
-                    let mut s = scene.clone();
-                    s.region = Some(reg.clone());
-                    match move_catoms(&mut s, &from, &targets, strict) {
-                        Ok(p) => {
-                            found = Some(p);
-                            break 'tries;
-                        }
-                        Err(c) => last = c,
-                    }
-                }
             }
-            let paths = found.ok_or(PlanError::Stuck(goal_meta, last))?;
-            // The next streamline plans against this one's end state.
-            for p in &paths {
-                let (a, b) = (p[0].from, p[p.len() - 1].to);
-                let id = scene.at.remove(&a).expect("mover in place");
-                scene.insert(id, b);
+            if progress {
+                break;
             }
-            let mut lane = Vec::new();
-            for p in paths {
-                let start = p[0].from;
-                for h in p {
-                    lane.push((start, h));
-                }
-            }
-            lanes.push(lane);
-            goals.push(goal_meta);
-            state.remove(&src);
-            state.insert(goal_meta, State::Sparse);
         }
+        if planned.is_empty() {
+            return Err(match stuck {
+                Some((m, c)) => PlanError::Stuck(m, c),
+                None => PlanError::Unreachable(
+                    empty_sorted
+                        .first()
+                        .or(extra.first())
+                        .copied()
+                        .unwrap_or(gc),
+                ),
+            });
+        }
+        let streamlines = planned;
         let motions: usize = lanes.iter().map(Vec::len).sum();
         scene = before.clone();
         if merge_lanes(&mut scene, lanes.clone(), rules, &mut out).is_err() {
@@ -299,6 +309,44 @@ pub fn plan(
             streamlines: streamlines.clone(),
         });
     }
+}
+
+/// The paths of a streamline's ten catoms to the goal meta-module's loop,
+/// planned against `scene`: inside the streamline's meta-module boxes
+/// first, then with one cell of margin, then anywhere in the structure's
+/// box grown by three cells (the ground cells of a goal beside the
+/// structure may be reachable only around it); strictly (no sliding
+/// contact) first in each. On failure, the first goal cell left unfilled.
+fn transport(scene: &Scene, line: &[Meta], goal_meta: Meta) -> Result<Vec<Vec<Hop>>, Cell> {
+    let from = line[0].sparse_cells();
+    let targets = goal_meta.sparse_cells();
+    let mut last = targets[0];
+    for margin in [Some(0), Some(1), None] {
+        let mut s = scene.clone();
+        match margin {
+            Some(margin) => {
+                let mut reg: FxHashSet<Cell> = FxHashSet::default();
+                for m in line.iter().chain([&goal_meta]) {
+                    for c in region(*m) {
+                        for dx in -margin..=margin {
+                            for dy in -margin..=margin {
+                                reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
+                            }
+                        }
+                    }
+                }
+                s.region = Some(reg);
+            }
+            None => s.fit_box(&targets, 3),
+        }
+        for strict in [true, false] {
+            match move_catoms(&mut s.clone(), &from, &targets, strict) {
+                Ok(p) => return Ok(p),
+                Err(c) => last = c,
+            }
+        }
+    }
+    Err(last)
 }
 
 /// Vertex-disjoint source → destination paths of maximum number.
