@@ -104,9 +104,10 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
                 Some(f) => format!("{name}: slope {:.2}, R² {:.3}", f.slope, f.r2),
                 None => name.to_string(),
             };
-            let dashed = k >= 2;
+            // The naive baseline's two series are drawn hollow.
+            let baseline = k >= 2;
             c.draw_series(pts.iter().map(|&p| {
-                if dashed {
+                if baseline {
                     Circle::new(p, 4, col.stroke_width(2))
                 } else {
                     Circle::new(p, 4, col.filled())
@@ -117,7 +118,7 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
             .legend(move |(x, y)| {
                 EmptyElement::at((x + 9, y))
                     + PathElement::new([(-9, 0), (9, 0)], col.stroke_width(1))
-                    + if dashed {
+                    + if baseline {
                         Circle::new((0, 0), 4, col.stroke_width(2))
                     } else {
                         Circle::new((0, 0), 4, col.filled())
