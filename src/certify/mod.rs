@@ -26,6 +26,7 @@ pub use world::{Move, StepPlan, World};
 use crate::error::InputError;
 use crate::progress::Reporter;
 use crate::schedule::Schedule;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -50,8 +51,22 @@ pub struct Options {
     pub base_dir: Option<PathBuf>,
     /// Steps per range for the checks that run over ranges of steps in
     /// parallel (see [`StepCheck::for_range`]): `None` chooses from the
-    /// number of threads, `Some(0)` runs every check in one pass.
+    /// schedule's length alone, `Some(0)` runs every check in one pass.
     pub range_steps: Option<usize>,
+    /// Called as each range of steps ends, with its wall time (scaling
+    /// studies: where the time of a parallel run went).
+    pub range_done: Option<fn(&RangeDone)>,
+}
+
+/// A range of steps that has been checked, and how long it took.
+#[derive(Clone, Debug)]
+pub struct RangeDone {
+    /// Its index among the schedule's ranges.
+    pub index: usize,
+    /// Its first and last step (1-based, inclusive).
+    pub steps: (usize, usize),
+    /// Wall time, in seconds.
+    pub seconds: f64,
 }
 
 impl Options {
@@ -76,6 +91,7 @@ impl Default for Options {
             model: None,
             base_dir: None,
             range_steps: None,
+            range_done: None,
         }
     }
 }
@@ -146,8 +162,11 @@ pub trait StepCheck: Send + Sync {
     }
 }
 
-/// Ranges a schedule's ranged checks are split into by default.
-const RANGES: usize = 16;
+/// Ranges a schedule's ranged checks are split into by default: enough
+/// that handing them out costliest first balances 16 workers (a range is
+/// then at most a few per cent of the work), few enough that the scenes
+/// kept at their starts stay small beside the structure.
+const RANGES: usize = 64;
 
 /// Steps per range for `steps` steps: about [`RANGES`] ranges of at least
 /// 16 steps, whatever the number of threads. A ranged check starts each
@@ -333,6 +352,7 @@ pub fn certify_on(
             range,
             last: report.per_step.len(),
             bar,
+            done: opts.range_done,
         };
         let mut outcomes = runner.run(&jobs)?;
         outcomes.sort_by_key(|(k, _)| *k);
@@ -356,12 +376,48 @@ pub struct Ranges<'a> {
     range: usize,
     last: usize,
     bar: &'a Reporter,
+    done: Option<fn(&RangeDone)>,
 }
 
 impl Ranges<'_> {
     /// How many ranges there are (some may lie past a stop and be empty).
     pub fn count(&self) -> usize {
         self.starts.len()
+    }
+
+    /// The range handed out `k`-th: the last first, since structures grow
+    /// over a schedule and late ranges cost the most; the cheap early ones
+    /// then fill the gaps at the end (longest job first balances workers).
+    pub fn in_handout_order(&self, k: usize) -> usize {
+        self.count() - 1 - k
+    }
+
+    /// Runs ranges on this process's threads, each thread taking the next
+    /// range index from `next` until it returns `None`: a shared counter
+    /// in one process, a dispatcher across processes. Returns every step's
+    /// findings (any order); after an error a thread takes no more ranges,
+    /// the others finish theirs, and the first error is returned.
+    pub fn pull(
+        &self,
+        next: &(dyn Fn() -> Option<usize> + Sync),
+    ) -> Result<Vec<(usize, StepOutcome)>, InputError> {
+        let threads = rayon::current_num_threads().max(1);
+        let parts: Vec<Result<Vec<(usize, StepOutcome)>, InputError>> = (0..threads)
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|_| {
+                let mut mine = Vec::new();
+                while let Some(i) = next() {
+                    mine.extend(self.run(i)?);
+                }
+                Ok(mine)
+            })
+            .collect();
+        let mut all = Vec::new();
+        for p in parts {
+            all.extend(p?);
+        }
+        Ok(all)
     }
 
     /// Runs range `i` (0-based): every step's findings, as (0-based step,
@@ -377,8 +433,10 @@ impl Ranges<'_> {
             .iter()
             .map(|c| c.for_range().expect("a ranged check makes range instances"))
             .collect();
+        let clock = std::time::Instant::now();
         let mut world = start.clone();
-        for k in *first..(first + self.range).min(self.last) {
+        let end = (first + self.range).min(self.last);
+        for k in *first..end {
             let (out, _, _) = advance(&mut world, self.schedule, k, |ctx| {
                 let mut out = StepOutcome::default();
                 for c in &checks {
@@ -389,6 +447,13 @@ impl Ranges<'_> {
             found.push((k, out));
             self.bar.advance(1);
         }
+        if let Some(done) = self.done {
+            done(&RangeDone {
+                index: i,
+                steps: (first + 1, end),
+                seconds: clock.elapsed().as_secs_f64(),
+            });
+        }
         Ok(found)
     }
 }
@@ -398,17 +463,18 @@ pub trait RangeRunner {
     fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError>;
 }
 
-/// Runs the ranges on this process's threads (rayon).
+/// Runs the ranges on this process's threads (rayon), handed out from a
+/// shared counter in [`Ranges::in_handout_order`].
 pub struct Threads;
 
 impl RangeRunner for Threads {
     fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-        use rayon::prelude::*;
-        let per_range: Vec<Vec<(usize, StepOutcome)>> = (0..ranges.count())
-            .into_par_iter()
-            .map(|i| ranges.run(i))
-            .collect::<Result<_, InputError>>()?;
-        Ok(per_range.into_iter().flatten().collect())
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let n = ranges.count();
+        ranges.pull(&|| {
+            let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            (k < n).then(|| ranges.in_handout_order(k))
+        })
     }
 }
 

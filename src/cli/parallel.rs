@@ -9,6 +9,8 @@ use reconfcheck::certify::{RangeRunner, Threads};
 use reconfcheck::certify::{Ranges, StepOutcome};
 use reconfcheck::error::{Error, InputError};
 use std::sync::OnceLock;
+#[cfg(feature = "mpi")]
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// This process's rank and the number of processes (0 of 1 without MPI).
 static PLACE: OnceLock<(usize, usize)> = OnceLock::new();
@@ -74,33 +76,27 @@ pub fn run(command: impl FnOnce() -> Result<u8, Error>) -> Result<u8, Error> {
     }
 }
 
-/// The threads' runner for a subset of ranges: what each process uses for
-/// its own share.
-#[cfg(feature = "mpi")]
-fn run_ranges(
-    ranges: &Ranges<'_>,
-    share: &[usize],
-) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-    use rayon::prelude::*;
-    let parts: Vec<Vec<(usize, StepOutcome)>> = share
-        .par_iter()
-        .map(|&i| ranges.run(i))
-        .collect::<Result<_, InputError>>()?;
-    Ok(parts.into_iter().flatten().collect())
-}
-
 #[cfg(feature = "mpi")]
 mod mpi_session {
     use super::*;
+    use mpi::point_to_point::MatchedReceiveVec;
     use mpi::topology::SimpleCommunicator;
     use mpi::traits::*;
 
     /// Set once MPI is initialised (the communicator itself is not
-    /// `Sync`, so it is fetched where needed).
-    static ON: OnceLock<()> = OnceLock::new();
+    /// `Sync`, so it is fetched where needed); holds whether MPI granted
+    /// calls from several threads at once, which the dispatcher needs.
+    static ON: OnceLock<bool> = OnceLock::new();
+
+    /// A thread asks rank 0 for a range (empty message).
+    const ASK: mpi::Tag = 11;
+    /// Rank 0's answer: a range index, or −1 for "none left".
+    const GIVE: mpi::Tag = 12;
+    /// A rank's findings, sent once to rank 0.
+    const PART: mpi::Tag = 13;
 
     pub fn world() -> Option<Mpi> {
-        ON.get().map(|_| Mpi)
+        ON.get().map(|&dispatch| Mpi { dispatch })
     }
 
     fn comm() -> SimpleCommunicator {
@@ -109,13 +105,14 @@ mod mpi_session {
 
     /// Initialises MPI, runs `command`, broadcasts rank 0's exit code.
     pub fn run(command: impl FnOnce() -> Result<u8, Error>) -> Result<u8, Error> {
-        let universe = mpi::initialize().ok_or_else(|| {
-            InputError::new("MPI could not be initialised (was it initialised twice?)")
-        })?;
+        let (universe, granted) = mpi::initialize_with_threading(mpi::Threading::Multiple)
+            .ok_or_else(|| {
+                InputError::new("MPI could not be initialised (was it initialised twice?)")
+            })?;
         let world = universe.world();
         let place = (world.rank() as usize, world.size() as usize);
         let _ = PLACE.set(place);
-        let _ = ON.set(());
+        let _ = ON.set(granted == mpi::Threading::Multiple);
         let result = command();
         // Rank 0's verdict is everyone's; an error on rank 0 is code 2 or 3.
         let mut code: u8 = match &result {
@@ -134,39 +131,139 @@ mod mpi_session {
         Ok(code)
     }
 
-    /// Runs each process's share of the ranges and gathers them on rank 0.
-    pub struct Mpi;
-
-    type Part = Result<Vec<(usize, StepOutcome)>, String>;
+    /// Runs the ranges over the processes and gathers them on rank 0.
+    ///
+    /// With MPI's full thread support, ranges are handed out one at a
+    /// time, costliest first, by a dispatcher thread on rank 0 (a range's
+    /// cost varies tenfold over a schedule, so a fixed split leaves most
+    /// processes idle behind the one with the late ranges). Without it,
+    /// rank r runs ranges r, r + N, …. Either way the findings are merged
+    /// in step order, so the report does not depend on who ran what.
+    pub struct Mpi {
+        dispatch: bool,
+    }
 
     impl RangeRunner for Mpi {
         fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-            let share = my_share(ranges.count(), "ranges of steps")?;
-            let mine: Part = run_ranges(ranges, &share).map_err(|e| e.to_string());
-            gather(mine)
+            let n = ranges.count();
+            // Every process must get work, whichever way it is handed out.
+            let share = my_share(n, "ranges of steps")?;
+            if !self.dispatch {
+                let mine = ranges.pull(&take_from(&share));
+                return gather(mine.map_err(|e| e.to_string()));
+            }
+            if comm().rank() != 0 {
+                let mine = ranges.pull(&|| ask_rank_0(&comm()));
+                return gather(mine.map_err(|e| e.to_string()));
+            }
+            // Rank 0's own threads take ranges from the counter; the
+            // dispatcher alone talks to the other ranks (answers and
+            // parts), so MPI is never called from two threads at once here.
+            let next = AtomicUsize::new(0);
+            std::thread::scope(|s| {
+                let dispatcher = s.spawn(|| serve(n, ranges, &next));
+                let mine = ranges.pull(&|| {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    (k < n).then(|| ranges.in_handout_order(k))
+                });
+                let parts = dispatcher.join().expect("the dispatcher does not panic");
+                combine(mine.map_err(|e| e.to_string()), parts)
+            })
         }
     }
 
+    /// A fixed share, taken in order by the process's threads.
+    fn take_from(share: &[usize]) -> impl Fn() -> Option<usize> + Sync + '_ {
+        let next = AtomicUsize::new(0);
+        move || share.get(next.fetch_add(1, Ordering::Relaxed)).copied()
+    }
+
+    /// One thread's request for its next range. Answers may cross between
+    /// a process's threads; each ask gets one answer, so they balance.
+    fn ask_rank_0(world: &SimpleCommunicator) -> Option<usize> {
+        let root = world.process_at_rank(0);
+        root.send_with_tag(&0u8, ASK);
+        let (i, _) = root.receive_with_tag::<i64>(GIVE);
+        usize::try_from(i).ok()
+    }
+
+    /// Rank 0's dispatcher: answers every ask with the next range (or −1)
+    /// and collects the other ranks' parts, until it has them all. It
+    /// polls, sleeping between empty polls, so that it does not take a
+    /// core from the ranges.
+    fn serve(n: usize, ranges: &Ranges<'_>, next: &AtomicUsize) -> Vec<(i32, Vec<u8>)> {
+        let world = comm();
+        let mut parts = Vec::new();
+        while parts.len() + 1 < world.size() as usize {
+            let Some((msg, status)) = world.any_process().immediate_matched_probe() else {
+                std::thread::sleep(std::time::Duration::from_micros(200));
+                continue;
+            };
+            if status.tag() == PART {
+                parts.push((
+                    status.source_rank(),
+                    (msg, status).matched_receive_vec::<u8>().0,
+                ));
+                continue;
+            }
+            let _: (u8, _) = msg.matched_receive();
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            let answer = if k < n {
+                ranges.in_handout_order(k) as i64
+            } else {
+                -1
+            };
+            world
+                .process_at_rank(status.source_rank())
+                .send_with_tag(&answer, GIVE);
+        }
+        parts
+    }
+
     /// Sends every rank's part to rank 0, which returns them all; other
-    /// ranks return nothing. Every rank sends, errors included, so that
-    /// rank 0 never waits for a message that will not come.
+    /// ranks return nothing. Rank 0 receives every part before it reports
+    /// any error, so that no rank is left blocked in its send.
     pub fn gather<T: serde::Serialize + serde::de::DeserializeOwned>(
         mine: Result<Vec<T>, String>,
     ) -> Result<Vec<T>, InputError> {
         let world = comm();
-        let bytes = rmp_serde::to_vec(&mine).expect("parts serialise");
+        let bytes = encode(&mine);
         if world.rank() != 0 {
-            world.process_at_rank(0).send(&bytes[..]);
+            world.process_at_rank(0).send_with_tag(&bytes[..], PART);
             return mine.map(|_| Vec::new()).map_err(InputError::new);
         }
-        let mut all = mine.map_err(InputError::new)?;
-        for r in 1..world.size() {
-            let (msg, _) = world.process_at_rank(r).receive_vec::<u8>();
-            let part: Result<Vec<T>, String> = rmp_serde::from_slice(&msg)
-                .map_err(|e| InputError::new(format!("rank {r} sent an unreadable part: {e}")))?;
-            all.extend(part.map_err(|e| InputError::new(format!("rank {r}: {e}")))?);
+        let parts = (1..world.size())
+            .map(|r| {
+                (
+                    r,
+                    world.process_at_rank(r).receive_vec_with_tag::<u8>(PART).0,
+                )
+            })
+            .collect();
+        combine(mine, parts)
+    }
+
+    /// Rank 0's findings and the other ranks' encoded parts, together;
+    /// the first error if any rank had one.
+    fn combine<T: serde::de::DeserializeOwned>(
+        mine: Result<Vec<T>, String>,
+        parts: Vec<(i32, Vec<u8>)>,
+    ) -> Result<Vec<T>, InputError> {
+        let mut all = Vec::new();
+        let mut first_error = mine.map(|m| all.extend(m)).err().map(InputError::new);
+        for (r, msg) in parts {
+            let part = decode::<T>(&msg)
+                .map_err(|e| InputError::new(format!("rank {r} sent an unreadable part: {e}")))
+                .and_then(|p| p.map_err(|e| InputError::new(format!("rank {r}: {e}"))));
+            match part {
+                Ok(p) => all.extend(p),
+                Err(e) => first_error = first_error.or(Some(e)),
+            }
         }
-        Ok(all)
+        match first_error {
+            Some(e) => Err(e),
+            None => Ok(all),
+        }
     }
 }
 
@@ -180,4 +277,47 @@ pub fn gather<T: serde::Serialize + serde::de::DeserializeOwned>(
         return mpi_session::gather(mine.map_err(|e| e.to_string()));
     }
     mine
+}
+
+/// A rank's part as MessagePack, with field names: the report's types skip
+/// fields at their default (a violation's `severity`, empty maps), which a
+/// positional encoding cannot tell apart from the next field.
+#[cfg(feature = "mpi")]
+fn encode<T: serde::Serialize>(part: &Result<Vec<T>, String>) -> Vec<u8> {
+    rmp_serde::to_vec_named(part).expect("parts serialise")
+}
+
+#[cfg(feature = "mpi")]
+fn decode<T: serde::de::DeserializeOwned>(
+    bytes: &[u8],
+) -> Result<Result<Vec<T>, String>, rmp_serde::decode::Error> {
+    rmp_serde::from_slice(bytes)
+}
+
+#[cfg(all(test, feature = "mpi"))]
+mod tests {
+    use super::*;
+    use reconfcheck::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
+    use reconfcheck::certify::{Options, certify};
+
+    #[test]
+    fn a_part_with_violations_and_skipped_fields_comes_back_whole() {
+        // The 2-pyramid at b = 9 is overloaded from step 84 on: its
+        // violations skip `severity` (an error) in the encoding.
+        let s = scaffold_schedule(&ShapeSpec::Pyramid { h: 2 }, 9).unwrap();
+        let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+        let opts = Options {
+            model: Some(models.join("catom-3.6mm.toml")),
+            ..Default::default()
+        };
+        let report = certify(&s, &opts).unwrap();
+        assert!(!report.violations.is_empty());
+        let part: Result<Vec<_>, String> = Ok(report.violations.clone());
+        let back: Result<Vec<reconfcheck::certify::Violation>, String> =
+            decode(&encode(&part)).unwrap();
+        assert_eq!(
+            serde_json::to_string(&back.unwrap()).unwrap(),
+            serde_json::to_string(&report.violations).unwrap()
+        );
+    }
 }

@@ -19,6 +19,7 @@ use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
 use super::structure::{End, Link, Structure};
 use glam::DVec3;
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use std::sync::Arc;
 
@@ -956,8 +957,14 @@ impl Analyzer {
             out.runs += usize::from(rigid.iterations > 0);
             out.rigid = lowest(out.rigid, rigid.lambda);
         }
+        // The poses' problems are independent: past the first (a failing
+        // step usually fails there), they are solved in waves of as many
+        // as there are threads, ahead of the sequential logic below, which
+        // alone decides what counts, so results do not depend on threads.
+        let mut solved: Vec<Option<limit::LimitResult>> = failing.iter().map(|_| None).collect();
+        let mut wave = 1;
         let mut failed = false;
-        for &(pose, bound) in failing {
+        for (i, &(_, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
             }
@@ -975,8 +982,23 @@ impl Analyzer {
                 }
                 continue;
             }
-            let loads = body_loads(s, pose);
-            let cap = limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities);
+            if solved[i].is_none() {
+                let end = (i + wave).min(failing.len());
+                let results: Vec<limit::LimitResult> = failing[i..end]
+                    .par_iter()
+                    .map(|&(pose, _)| {
+                        let loads = body_loads(s, pose);
+                        limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities)
+                    })
+                    .collect();
+                for (slot, r) in solved[i..end].iter_mut().zip(results) {
+                    *slot = Some(r);
+                }
+                wave = rayon::current_num_threads().max(1);
+            }
+            let cap = solved[i]
+                .take()
+                .expect("solved in this wave or an earlier one");
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());

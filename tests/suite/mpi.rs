@@ -69,6 +69,58 @@ fn two_processes_certify_to_the_same_report_as_one() {
 
 #[cfg(feature = "mpi")]
 #[test]
+fn three_processes_certify_an_overloaded_schedule_to_the_same_report_as_one() {
+    // The 2-pyramid at b = 9 is overloaded from step 84 on: its violations
+    // travel between ranks (their encoding skips default fields), and its
+    // 8 ranges are handed out one by one by rank 0's dispatcher.
+    let scenario = scratch("p2b9.toml");
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "name = \"p2b9\"\nalgorithm = \"scaffold\"\nmodel = {:?}\n\n[parameters]\nshape = \"pyramid\"\nh = 2\nb = 9\n",
+            model.display().to_string()
+        ),
+    )
+    .unwrap();
+    let (one, three) = (scratch("p2b9-1.json"), scratch("p2b9-3.json"));
+    let run = |out: &PathBuf| {
+        vec![
+            "run".to_string(),
+            scenario.display().to_string(),
+            "--no-progress".into(),
+            format!("--json={}", out.display()),
+        ]
+    };
+    let (a1, a3) = (run(&one), run(&three));
+    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
+    let b = mpirun(3, &a3.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(
+        a.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&a.stderr)
+    );
+    assert_eq!(
+        b.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
+    let report = std::fs::read(&one).unwrap();
+    assert!(
+        String::from_utf8_lossy(&report).contains("\"overload\""),
+        "violations were found"
+    );
+    assert!(
+        report == std::fs::read(&three).unwrap(),
+        "the reports differ"
+    );
+    assert_eq!(a.stdout, b.stdout);
+}
+
+#[cfg(feature = "mpi")]
+#[test]
 fn two_processes_study_the_same_branch_lengths_as_one() {
     let (one, two) = (scratch("b1.json"), scratch("b2.json"));
     let args = |p: &PathBuf| {
