@@ -589,6 +589,7 @@ pub fn certify_atoms(s: &Schedule, rest: AtomRest, opts: &Options) -> Result<Rep
         steps: s.steps.len(),
         moves: operations,
         checks: names,
+        load_factor_tolerance: 0.0,
         certified: false,
         stopped_at: None,
         violations: Vec::new(),

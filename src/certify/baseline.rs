@@ -189,6 +189,7 @@ mod tests {
             steps: utilisations.len(),
             moves: 0,
             checks: vec![],
+            load_factor_tolerance: 0.0,
             certified: violations.is_empty(),
             stopped_at: None,
             violations,

@@ -168,6 +168,7 @@ mod tests {
             steps: 3,
             moves: 3,
             checks: vec!["lattice".into(), "collision".into()],
+            load_factor_tolerance: 0.0,
             certified: false,
             stopped_at: None,
             violations: vec![v],

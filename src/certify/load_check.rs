@@ -26,6 +26,9 @@ pub struct LoadCheck {
     /// The model at the schedule's spacing, and whether to reuse work.
     model: Model,
     incremental: bool,
+    /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`] of
+    /// every analyser it makes.
+    load_factor_tolerance: f64,
 }
 
 impl LoadCheck {
@@ -53,7 +56,22 @@ impl LoadCheck {
             analyzer: Mutex::new(Analyzer::new(model.clone(), incremental)),
             model,
             incremental,
+            load_factor_tolerance: 0.0,
         }
+    }
+
+    /// This check with the limit analysis's factor reported within
+    /// `tolerance` of the exact one (see
+    /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`]);
+    /// 0 is exact.
+    pub fn with_load_factor_tolerance(mut self, tolerance: f64) -> LoadCheck {
+        self.load_factor_tolerance = tolerance;
+        self.analyzer
+            .get_mut()
+            .expect("a fresh analyser")
+            .settings
+            .load_factor_tolerance = tolerance;
+        self
     }
 
     fn analyse(
@@ -235,10 +253,10 @@ impl StepCheck for LoadCheck {
     /// so ranges of steps run in parallel, each with its own analyser: the
     /// reuse between steps is lost only at a range's first step.
     fn for_range(&self) -> Option<Box<dyn StepCheck>> {
-        Some(Box::new(LoadCheck::at_spacing(
-            self.model.clone(),
-            self.incremental,
-        )))
+        Some(Box::new(
+            LoadCheck::at_spacing(self.model.clone(), self.incremental)
+                .with_load_factor_tolerance(self.load_factor_tolerance),
+        ))
     }
 
     fn ranged(&self) -> bool {

@@ -56,6 +56,10 @@ pub struct Options {
     /// Called as each range of steps ends, with its wall time (scaling
     /// studies: where the time of a parallel run went).
     pub range_done: Option<fn(&RangeDone)>,
+    /// How far below the exact smallest load factor of a step's poses the
+    /// reported one may lie (0: exact; see
+    /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`]).
+    pub load_factor_tolerance: f64,
 }
 
 /// A range of steps that has been checked, and how long it took.
@@ -92,6 +96,7 @@ impl Default for Options {
             base_dir: None,
             range_steps: None,
             range_done: None,
+            load_factor_tolerance: 0.0,
         }
     }
 }
@@ -206,7 +211,9 @@ pub fn checks_for(
                 e.message
             ))
         })?;
-        checks.push(Box::new(check));
+        checks.push(Box::new(
+            check.with_load_factor_tolerance(opts.load_factor_tolerance),
+        ));
     }
     Ok(checks)
 }
@@ -293,11 +300,10 @@ pub fn certify_with_model(
         return certify(schedule, opts);
     }
     let mut checks = geometric_checks(schedule, opts);
-    checks.push(Box::new(LoadCheck::new(
-        model,
-        schedule.spacing.metres(),
-        true,
-    )?));
+    checks.push(Box::new(
+        LoadCheck::new(model, schedule.spacing.metres(), true)?
+            .with_load_factor_tolerance(opts.load_factor_tolerance),
+    ));
     let refs: Vec<&dyn StepCheck> = checks.iter().map(|c| c.as_ref()).collect();
     certify_on(schedule, opts, &refs, &Threads)
 }
@@ -490,6 +496,7 @@ fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) 
         steps: schedule.steps.len(),
         moves: schedule.move_count(),
         checks: checks.iter().map(|c| c.name().to_string()).collect(),
+        load_factor_tolerance: opts.load_factor_tolerance,
         certified: false,
         stopped_at: None,
         violations: Vec::new(),

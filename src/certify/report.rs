@@ -191,6 +191,10 @@ pub struct Report {
     pub moves: usize,
     /// Names of the checks that were run.
     pub checks: Vec<String>,
+    /// How far below the exact smallest load factor of a step's poses the
+    /// reported ones may lie (`--load-factor-tolerance`); absent when exact.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub load_factor_tolerance: f64,
     pub certified: bool,
     /// Set when a violation left the state undefined (two modules in one
     /// cell) and later steps could not be checked.
@@ -199,6 +203,10 @@ pub struct Report {
     pub violations: Vec<Violation>,
     pub warnings: Vec<Violation>,
     pub per_step: Vec<StepResult>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 pub const REPORT_FORMAT: &str = "reconfcheck-report";
@@ -297,6 +305,13 @@ impl Report {
             self.moves
         );
         let _ = writeln!(s, "checks: {}", self.checks.join(", "));
+        if self.load_factor_tolerance > 0.0 {
+            let _ = writeln!(
+                s,
+                "load factors within {} of the exact ones (--load-factor-tolerance); verdicts exact",
+                self.load_factor_tolerance
+            );
+        }
         let (checked, not_checked) = self.coverage();
         let _ = writeln!(s, "checked: {}", checked.join("; "));
         for n in &not_checked {
@@ -389,6 +404,7 @@ mod tests {
             steps: 9,
             moves: 9,
             checks: vec!["lattice".into()],
+            load_factor_tolerance: 0.0,
             certified: violations.is_empty(),
             stopped_at: None,
             violations,

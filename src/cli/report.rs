@@ -52,6 +52,11 @@ pub struct ReportArgs {
     /// a 3D replay of the schedule with its findings (no network needed).
     #[arg(long, value_name = "REPORT.html")]
     html: Option<std::path::PathBuf>,
+    /// Report each step's limit-analysis load factor within this fraction
+    /// of the exact one, in [0, 0.5): poses whose factor is bounded from a
+    /// solved neighbour are not solved. Verdicts stay exact. 0 is exact.
+    #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
+    load_factor_tolerance: f64,
 }
 
 impl ReportArgs {
@@ -60,6 +65,13 @@ impl ReportArgs {
     pub fn options(&self, origin: &Path) -> Result<Options, Error> {
         let epsilon =
             Tolerance::new(self.epsilon).map_err(|e| InputError::new(format!("--epsilon: {e}")))?;
+        let t = self.load_factor_tolerance;
+        if !(0.0..0.5).contains(&t) {
+            return Err(InputError::new(format!(
+                "--load-factor-tolerance: {t} is not a fraction in [0, 0.5)"
+            ))
+            .into());
+        }
         Ok(Options {
             name: origin.display().to_string(),
             progress: super::progress::reporter(
@@ -75,6 +87,7 @@ impl ReportArgs {
             range_done: std::env::var_os("RECONFCHECK_RANGE_TIMES")
                 .is_some()
                 .then_some(print_range_time),
+            load_factor_tolerance: t,
         })
     }
 }

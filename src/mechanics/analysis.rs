@@ -190,6 +190,14 @@ pub struct Settings {
     /// corner forces too ([`corner_ratio`]). Off only to measure what the
     /// gate changes.
     pub corner_gate: bool,
+    /// How far below the exact smallest load factor of a step's poses the
+    /// reported one may lie, as a fraction (0: exact, every pose the
+    /// screen could not clear solved). Above 0, a pose whose factor is
+    /// bounded from the nearest solved pose's equilibrium
+    /// ([`limit::bound_from`]) at ≥ 1 and ≥ (1 − tolerance) × the smallest
+    /// found is not solved: verdicts stay exact (a skipped pose holds),
+    /// the factor is within the tolerance.
+    pub load_factor_tolerance: f64,
 }
 
 impl Default for Settings {
@@ -201,6 +209,7 @@ impl Default for Settings {
             reuse_max_changed: REUSE_MAX_CHANGED,
             envelope: true,
             corner_gate: true,
+            load_factor_tolerance: 0.0,
         }
     }
 }
@@ -316,6 +325,13 @@ fn local_loads(s: &Structure, pose: Option<usize>, local: &[u32]) -> Vec<Vec6> {
         .filter(|(b, _)| local[*b] != u32::MAX)
         .map(|(_, f)| f)
         .collect()
+}
+
+/// Whether a pose whose load factor is at least `bound` need not be
+/// solved: it holds (`bound ≥ 1`), and it could lower the smallest factor
+/// found so far by at most `tolerance` of it. NaN anywhere: no.
+fn spared(bound: f64, smallest: f64, tolerance: f64) -> bool {
+    tolerance > 0.0 && bound >= 1.0 && bound >= (1.0 - tolerance) * smallest
 }
 
 /// The smaller factor; a NaN (a failed solve) sticks, so that it reads as
@@ -961,10 +977,13 @@ impl Analyzer {
         // step usually fails there), they are solved in waves of as many
         // as there are threads, ahead of the sequential logic below, which
         // alone decides what counts, so results do not depend on threads.
-        let mut solved: Vec<Option<limit::LimitResult>> = failing.iter().map(|_| None).collect();
+        let mut solved: Vec<Option<(limit::LimitResult, Option<limit::Field>)>> =
+            failing.iter().map(|_| None).collect();
+        let tolerance = self.settings.load_factor_tolerance;
+        let mut fields: Vec<(Option<usize>, limit::Field)> = Vec::new();
         let mut wave = 1;
         let mut failed = false;
-        for (i, &(_, bound)) in failing.iter().enumerate() {
+        for (i, &(pose, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
             }
@@ -982,28 +1001,76 @@ impl Analyzer {
                 }
                 continue;
             }
+            if tolerance > 0.0
+                && !fields.is_empty()
+                && spared(
+                    self.pose_bound(s, part, &fields, pose),
+                    out.capacities,
+                    tolerance,
+                )
+            {
+                continue;
+            }
             if solved[i].is_none() {
                 let end = (i + wave).min(failing.len());
-                let results: Vec<limit::LimitResult> = failing[i..end]
+                let results: Vec<_> = failing[i..end]
                     .par_iter()
                     .map(|&(pose, _)| {
                         let loads = body_loads(s, pose);
-                        limit::load_factor(s, &self.model, &loads, part, Connectors::Capacities)
+                        limit::load_factor_with_field(
+                            s,
+                            &self.model,
+                            &loads,
+                            part,
+                            Connectors::Capacities,
+                        )
                     })
                     .collect();
                 for (slot, r) in solved[i..end].iter_mut().zip(results) {
                     *slot = Some(r);
                 }
-                wave = rayon::current_num_threads().max(1);
+                // With a tolerance, poses are judged one by one: a solved
+                // pose may spare the next ones.
+                if tolerance == 0.0 {
+                    wave = rayon::current_num_threads().max(1);
+                }
             }
-            let cap = solved[i]
+            let (cap, field) = solved[i]
                 .take()
                 .expect("solved in this wave or an earlier one");
+            if let (Some(f), true) = (field, tolerance > 0.0) {
+                fields.push((pose, f));
+            }
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
         out
+    }
+
+    /// A lower bound of the load factor at `pose` from the equilibrium of
+    /// the nearest pose already solved (0 when there is none).
+    fn pose_bound(
+        &self,
+        s: &Structure,
+        part: limit::Part<'_>,
+        fields: &[(Option<usize>, limit::Field)],
+        pose: Option<usize>,
+    ) -> f64 {
+        let Some((from, field)) = fields
+            .iter()
+            .min_by_key(|(p, _)| p.zip(pose).map_or(usize::MAX, |(a, b)| a.abs_diff(b)))
+        else {
+            return 0.0;
+        };
+        let extra: Vec<(usize, DVec3)> = (0..s.hanging.len())
+            .map(|h| {
+                let m = mover_moment(s, h, pose) - mover_moment(s, h, *from);
+                (s.hanging[h].pivot, m)
+            })
+            .collect();
+        let loads = body_loads(s, pose);
+        limit::bound_from(s, &self.model, &loads, part, field, &extra)
     }
 
     /// The actuator hold of each mover on its pivot, at its worst sampled
@@ -1395,5 +1462,26 @@ impl Components {
             End::Body(b) if !s.bodies[b].fixed => Some(self.of[b] as usize),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spared;
+
+    #[test]
+    fn a_pose_is_spared_only_when_it_provably_holds_within_the_tolerance() {
+        // Bounded at 1.2 while 1.25 was found: within 5 %, not within 1 %.
+        assert!(spared(1.2, 1.25, 0.05));
+        assert!(!spared(1.2, 1.25, 0.01));
+        // Exact: never.
+        assert!(!spared(1.3, 1.25, 0.0));
+        // A bound below 1 proves nothing about holding, however close.
+        assert!(!spared(0.99, 1.0, 0.05));
+        assert!(spared(1.0, 1.0, 0.05));
+        // NaN (a failed solve, a broken bound) never spares a pose.
+        assert!(!spared(f64::NAN, 1.25, 0.05));
+        assert!(!spared(1.2, f64::NAN, 0.05));
+        assert!(!spared(1.2, 1.25, f64::NAN));
     }
 }

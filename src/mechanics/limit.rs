@@ -82,6 +82,31 @@ pub fn load_factor(
     part: Part<'_>,
     which: Connectors,
 ) -> LimitResult {
+    load_factor_with_field(s, model, loads, part, which).0
+}
+
+/// An admissible equilibrium found by the limit analysis: the corner
+/// forces of `links` (in the program's columns) carrying `lambda` × the
+/// loads.
+#[derive(Clone, Debug)]
+pub struct Field {
+    links: Vec<usize>,
+    x: Vec<f64>,
+    lambda: f64,
+    /// The largest equilibrium residual of `x / lambda` under the loads
+    /// (the solver's own tolerance): a bound built on it may not do worse.
+    residual: f64,
+}
+
+/// [`load_factor`], with the equilibrium that carries it (none for the
+/// rigid case, a failed solve, or a part held by a fixed module).
+pub fn load_factor_with_field(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    which: Connectors,
+) -> (LimitResult, Option<Field>) {
     let nb = s.bodies.len();
     // Equation groups: with capacities, every free body of the part is
     // balanced on its own (moments about its centre); with rigid
@@ -125,10 +150,11 @@ pub fn load_factor(
         .collect();
     if rigid && links.iter().any(|&li| !s.links[li].is_ground()) {
         // Held by a fixed module through rigid connectors: any load.
-        return LimitResult {
+        let r = LimitResult {
             lambda: LAMBDA_CAP,
             iterations: 0,
         };
+        return (r, None);
     }
     let mut prog = Program::new(6 * n_groups, PER_LINK * links.len());
     let frame = Frame {
@@ -136,8 +162,38 @@ pub fn load_factor(
         origin: &origin,
     };
     equilibrium_rows(&mut prog, s, model, loads, part, &links, &frame);
+    let equilibrium = (!rigid).then(|| (prog.triplets.clone(), prog.rhs.len(), prog.lam));
     capacity_rows(&mut prog, s, model, &links);
-    maximise(prog)
+    let (r, x) = maximise(prog);
+    let field = x.filter(|_| !rigid && r.lambda.is_finite() && r.lambda > 0.0);
+    let field = field.zip(equilibrium).map(|(x, (triplets, rows, lam))| {
+        let v: Vec<f64> = x.iter().map(|x| x / r.lambda).collect();
+        let residual = max_residual(&triplets, rows, lam, &v);
+        Field {
+            links,
+            x,
+            lambda: r.lambda,
+            residual,
+        }
+    });
+    (r, field)
+}
+
+/// The largest |row| of `A v + A_λ` over the equilibrium rows (`λ = 1`).
+fn max_residual(
+    (ri, ci, vals): &(Vec<usize>, Vec<usize>, Vec<f64>),
+    rows: usize,
+    lam: usize,
+    v: &[f64],
+) -> f64 {
+    let mut residual = vec![0.0; rows];
+    for ((&r, &c), &a) in ri.iter().zip(ci).zip(vals) {
+        residual[r] += a * if c == lam { 1.0 } else { v[c] };
+    }
+    residual.iter().fold(
+        0.0,
+        |m: f64, r| if r.is_nan() { f64::NAN } else { m.max(r.abs()) },
+    )
 }
 
 /// Columns per corner of a contact square: the normal force `n` (tension
@@ -291,7 +347,7 @@ fn capacity_rows(prog: &mut Program, s: &Structure, model: &Model, links: &[usiz
 /// degenerate problems (free tangential forces circulating between
 /// corners) can stall on round-off: it retries with stronger
 /// regularisation of the KKT system before giving up (NaN).
-fn maximise(mut prog: Program) -> LimitResult {
+fn maximise(mut prog: Program) -> (LimitResult, Option<Vec<f64>>) {
     let lam = prog.lam;
     let ncol = lam + 1;
     prog.row(&[(lam, 1.0)], LAMBDA_CAP);
@@ -316,6 +372,7 @@ fn maximise(mut prog: Program) -> LimitResult {
     cones.extend(prog.socs.iter().map(|_| SecondOrderConeT(3)));
     let mut lambda = f64::NAN;
     let mut iterations = 0;
+    let mut x = None;
     for (regularisation, tolerance) in [(1e-8, 1e-8), (1e-6, 1e-7), (1e-5, 1e-6)] {
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
@@ -337,8 +394,329 @@ fn maximise(mut prog: Program) -> LimitResult {
             SolverStatus::Solved | SolverStatus::AlmostSolved
         ) {
             lambda = sol.x[lam].clamp(0.0, LAMBDA_CAP);
+            x = Some(sol.x[..lam].to_vec());
             break;
         }
     }
-    LimitResult { lambda, iterations }
+    (LimitResult { lambda, iterations }, x)
+}
+
+/// A lower bound of the load factor of `part` under `loads`, which differ
+/// from the loads `field` carries by pure moments `extra` (body, moment in
+/// `W·d`): a mover at another sample of its path turns its weight's arm,
+/// not its force. The candidate equilibrium is `field` scaled by `1/λ`
+/// plus, for each extra moment, a chain of pure couples through the links
+/// of a shortest path from its body to a support; the bound is the largest
+/// multiple of it within every capacity. The candidate is checked against
+/// the equilibrium equations of `loads` before it counts: 0 (no bound)
+/// where it does not balance them to `1e-9` of the loads.
+pub fn bound_from(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    field: &Field,
+    extra: &[(usize, glam::DVec3)],
+) -> f64 {
+    let nb = s.bodies.len();
+    let mut row_of = vec![usize::MAX; nb];
+    let mut n_groups = 0;
+    for &i in part.bodies {
+        if !s.bodies[i].fixed {
+            row_of[i] = 6 * n_groups;
+            n_groups += 1;
+        }
+    }
+    let is_free = |i: usize| row_of[i] != usize::MAX;
+    let mut col_of = vec![usize::MAX; s.links.len()];
+    for (k, &li) in field.links.iter().enumerate() {
+        col_of[li] = PER_LINK * k;
+    }
+    let mut v: Vec<f64> = field.x.iter().map(|x| x / field.lambda).collect();
+    // Links at each free body, for the paths.
+    let mut at: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    for &li in &field.links {
+        let l = &s.links[li];
+        at[l.a].push(li);
+        if let End::Body(b) = l.b {
+            at[b].push(li);
+        }
+    }
+    for &(body, m) in extra {
+        if m == glam::DVec3::ZERO {
+            continue;
+        }
+        if !is_free(body) {
+            // A fixed body or another part carries it: no load here.
+            continue;
+        }
+        let Some(path) = path_to_support(s, &at, &is_free, body) else {
+            return 0.0;
+        };
+        // Each link of the path passes the couple on: the body nearer the
+        // mover receives −m from it, the next one +m.
+        let mut cur = body;
+        for li in path {
+            let l = &s.links[li];
+            // Couple on side b: +m when `cur` is side a (a receives −m).
+            let (on_b, next) = if l.a == cur {
+                (m, l.b.body())
+            } else {
+                (-m, Some(l.a))
+            };
+            add_couple(
+                &mut v[col_of[li]..col_of[li] + PER_LINK],
+                s,
+                model,
+                li,
+                on_b,
+            );
+            match next {
+                Some(n) => cur = n,
+                None => break,
+            }
+        }
+    }
+    // The candidate must balance `loads` (λ = 1) on every free body as
+    // well as the solver's own equilibrium balanced its loads.
+    let mut prog = Program::new(6 * n_groups, PER_LINK * field.links.len());
+    let origin = |i: usize| s.bodies[i].centre;
+    let frame = Frame {
+        row_of: &row_of,
+        origin: &origin,
+    };
+    equilibrium_rows(&mut prog, s, model, loads, part, &field.links, &frame);
+    let residual = max_residual(&prog.triplets, prog.rhs.len(), prog.lam, &v);
+    let allowed = 1.01 * field.residual + 1e-12;
+    if residual.partial_cmp(&allowed).is_none_or(|o| o.is_gt()) {
+        return 0.0;
+    }
+    largest_admissible_multiple(s, model, &field.links, &v)
+}
+
+/// The links from `body` to the nearest support (the ground, or a body
+/// outside the free ones), fewest first (breadth-first).
+fn path_to_support(
+    s: &Structure,
+    at: &[Vec<usize>],
+    is_free: &dyn Fn(usize) -> bool,
+    body: usize,
+) -> Option<Vec<usize>> {
+    let mut came: Vec<Option<usize>> = vec![None; s.bodies.len()];
+    let mut seen = vec![false; s.bodies.len()];
+    seen[body] = true;
+    let mut queue = std::collections::VecDeque::from([body]);
+    while let Some(b) = queue.pop_front() {
+        for &li in &at[b] {
+            let l = &s.links[li];
+            let other = if l.a == b { l.b.body() } else { Some(l.a) };
+            let support = other.is_none_or(|o| !is_free(o));
+            if support {
+                let mut path = vec![li];
+                let mut x = b;
+                while let Some(prev) = came[x] {
+                    path.push(prev);
+                    let p = &s.links[prev];
+                    x = if p.a == x {
+                        p.b.body().expect("a path link joins two bodies")
+                    } else {
+                        p.a
+                    };
+                }
+                path.reverse();
+                return Some(path);
+            }
+            let o = other.expect("not a support");
+            if !seen[o] {
+                seen[o] = true;
+                came[o] = Some(li);
+                queue.push_back(o);
+            }
+        }
+    }
+    None
+}
+
+/// Adds to one link's corner forces a pure couple `m` on its side b
+/// (normal forces for the bending part, tangential ones for the torsion).
+fn add_couple(cols: &mut [f64], s: &Structure, model: &Model, li: usize, m: glam::DVec3) {
+    let l = &s.links[li];
+    let h = 0.5 * capacity(s, model, li).side / model.spacing;
+    let nrm = l.normal;
+    let m_n = m.dot(nrm);
+    let m_in = m - m_n * nrm;
+    // Normal forces n_k = α s_u + β s_v push along −normal on side b:
+    // their couple is −4h (α u×N̂ + β v×N̂).
+    let (eu, ev) = (l.u.cross(nrm), l.v.cross(nrm));
+    let alpha = -m_in.dot(eu) / (4.0 * h * eu.length_squared());
+    let beta = -m_in.dot(ev) / (4.0 * h * ev.length_squared());
+    // Tangential forces c·N̂ × r_k: their couple is 8h²c N̂.
+    let c = m_n / (8.0 * h * h);
+    for (ki, (su, sv)) in CORNERS.iter().enumerate() {
+        let r = h * (su * l.u + sv * l.v);
+        let t = c * nrm.cross(r);
+        let col = PER_CORNER * ki;
+        cols[col] += alpha * su + beta * sv;
+        cols[col + 1] += t.dot(l.u);
+        cols[col + 2] += t.dot(l.v);
+    }
+}
+
+/// The largest `μ ≤ LAMBDA_CAP` with `μ·v` within every capacity row and
+/// friction cone of `links` (tangential bounds `z` taken at `‖t‖`).
+fn largest_admissible_multiple(s: &Structure, model: &Model, links: &[usize], v: &[f64]) -> f64 {
+    let w = model.weight();
+    let mut mu = LAMBDA_CAP;
+    let mut limit = |lhs: f64, rhs: f64| {
+        if lhs > 0.0 {
+            mu = mu.min(if rhs > 0.0 { rhs / lhs } else { 0.0 });
+        } else if lhs.is_nan() {
+            mu = 0.0;
+        }
+    };
+    for (k, &li) in links.iter().enumerate() {
+        let cap = capacity(s, model, li);
+        let p = cap.tension() / w / 4.0;
+        let n = |ki: usize| v[PER_LINK * k + PER_CORNER * ki];
+        match cap.bending {
+            Bending::RigidHinge => (0..4).for_each(|ki| limit(n(ki), p)),
+            Bending::Elastic => {
+                for (eu, ev) in CORNERS {
+                    let lhs: f64 = CORNERS
+                        .iter()
+                        .enumerate()
+                        .map(|(ki, (su, sv))| (1.0 + 3.0 * (eu * su + ev * sv)) * n(ki))
+                        .sum();
+                    limit(lhs, 4.0 * p);
+                }
+            }
+        }
+        for ki in 0..4 {
+            let col = PER_LINK * k + PER_CORNER * ki;
+            let z = (v[col + 1] * v[col + 1] + v[col + 2] * v[col + 2]).sqrt();
+            limit(cap.friction * n(ki) + z, cap.friction * p);
+        }
+    }
+    mu
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::config::Ground;
+    use crate::lattice::{Cell, FccLattice};
+    use crate::mechanics::validation::structure;
+    use glam::DVec3;
+
+    /// Gravity on every body (units of `W`), as the analyser loads them.
+    fn gravity(s: &Structure) -> Vec<Vec6> {
+        let g = s.gravity;
+        vec![Vec6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0); s.bodies.len()]
+    }
+
+    fn with_moment(loads: &[Vec6], body: usize, m: DVec3) -> Vec<Vec6> {
+        let mut l = loads.to_vec();
+        l[body] += Vec6::new(0.0, 0.0, 0.0, m.x, m.y, m.z);
+        l
+    }
+
+    /// Bounds from the equilibrium under `loads` at each body, for moments
+    /// in many directions and sizes, against the limit analysis of the
+    /// changed loads itself: never above it, and not trivially low.
+    fn check_bounds(s: &Structure, model: &Model) -> usize {
+        let bodies: Vec<usize> = (0..s.bodies.len()).collect();
+        let links: Vec<usize> = (0..s.links.len()).collect();
+        let part = Part {
+            bodies: &bodies,
+            links: &links,
+        };
+        let base = gravity(s);
+        let (r, field) = load_factor_with_field(s, model, &base, part, Connectors::Capacities);
+        let field = field.expect("an equilibrium");
+        assert!(r.lambda > 1.0 && r.lambda < LAMBDA_CAP, "{}", r.lambda);
+        let mut tight = 0;
+        let dirs = [
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            DVec3::new(1.0, -2.0, 0.5),
+        ];
+        for body in bodies.iter().copied().filter(|&b| !s.bodies[b].fixed) {
+            for dir in dirs {
+                for size in [0.01, 0.1, 0.5] {
+                    let m = dir.normalize() * size;
+                    let loads = with_moment(&base, body, m);
+                    let bound = bound_from(s, model, &loads, part, &field, &[(body, m)]);
+                    let exact = load_factor(s, model, &loads, part, Connectors::Capacities).lambda;
+                    assert!(
+                        bound <= exact * (1.0 + 1e-6),
+                        "body {body}, moment {m}: bound {bound} above the load factor {exact}"
+                    );
+                    if size == 0.01 && bound >= 0.9 * exact {
+                        tight += 1;
+                    }
+                }
+            }
+        }
+        tight
+    }
+
+    #[test]
+    fn a_bound_from_a_neighbouring_load_case_never_exceeds_its_load_factor() {
+        let model = Model::default_catom();
+        // A cantilever from a fixed root, and its mirror image.
+        for sign in [1, -1] {
+            let cells: Vec<Cell> = (0..=4).map(|i| Cell::new(sign * i, 0, 0)).collect();
+            let s = structure(&FccLattice, None, &cells, &[0], &[]);
+            let tight = check_bounds(&s, &model);
+            assert!(
+                tight >= 4 * 6 / 2,
+                "small moments give close bounds: {tight}"
+            );
+        }
+        // A frame resting on the ground (no adhesion there), with an arm.
+        let ground = Some(Ground { layer: 0 });
+        let mut cells = vec![Cell::new(0, 0, 0), Cell::new(1, 0, 0), Cell::new(0, 1, 0)];
+        cells.extend([Cell::new(0, 0, 1), Cell::new(1, 0, 1), Cell::new(2, 0, 1)]);
+        let s = structure(&FccLattice, ground, &cells, &[], &[]);
+        check_bounds(&s, &model);
+    }
+
+    #[test]
+    fn a_candidate_that_does_not_balance_the_loads_gives_no_bound() {
+        let model = Model::default_catom();
+        let cells: Vec<Cell> = (0..=3).map(|i| Cell::new(i, 0, 0)).collect();
+        let s = structure(&FccLattice, None, &cells, &[0], &[]);
+        let bodies: Vec<usize> = (0..s.bodies.len()).collect();
+        let links: Vec<usize> = (0..s.links.len()).collect();
+        let part = Part {
+            bodies: &bodies,
+            links: &links,
+        };
+        let base = gravity(&s);
+        let (_, field) = load_factor_with_field(&s, &model, &base, part, Connectors::Capacities);
+        let field = field.unwrap();
+        let tip = s
+            .bodies
+            .iter()
+            .position(|b| b.cell == Cell::new(3, 0, 0))
+            .unwrap();
+        let m = DVec3::new(0.0, 0.1, 0.0);
+        let loads = with_moment(&base, tip, m);
+        // The moment is said to act elsewhere, or not at all: no bound.
+        assert_eq!(
+            bound_from(&s, &model, &loads, part, &field, &[(tip - 1, m)]),
+            0.0
+        );
+        assert_eq!(bound_from(&s, &model, &loads, part, &field, &[]), 0.0);
+        // A NaN moment gives none either.
+        let nan = DVec3::new(f64::NAN, 0.0, 0.0);
+        assert_eq!(
+            bound_from(&s, &model, &loads, part, &field, &[(tip, nan)]),
+            0.0
+        );
+        assert!(bound_from(&s, &model, &loads, part, &field, &[(tip, m)]) > 0.0);
+    }
 }

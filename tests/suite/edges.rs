@@ -289,3 +289,45 @@ fn model_fields_out_of_their_range_are_refused_naming_the_field() {
         assert!(err.contains(field), "{tag}: {err}");
     }
 }
+
+#[test]
+fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
+    for tol in ["nan", "inf", "-inf", "-0.01", "0.5", "1", "1e9"] {
+        let o = bin()
+            .args(["run", "--no-progress"])
+            .arg(format!("--load-factor-tolerance={tol}"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{tol}: {err}");
+        assert!(err.contains("--load-factor-tolerance"), "{tol}: {err}");
+        assert!(o.stdout.is_empty(), "{tol}: nothing certified");
+    }
+    // Accepted, the report records it, and the default scenario (whose
+    // steps the elastic screen clears) reads the same as the exact run.
+    let (exact, loose) = (scratch("lft-0.json"), scratch("lft-5.json"));
+    for (p, tol) in [(&exact, "0"), (&loose, "0.05")] {
+        let o = bin()
+            .args(["run", "--no-progress", "--json"])
+            .arg(p)
+            .arg(format!("--load-factor-tolerance={tol}"))
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let (a, b): (Value, Value) = (
+        serde_json::from_slice(&std::fs::read(&exact).unwrap()).unwrap(),
+        serde_json::from_slice(&std::fs::read(&loose).unwrap()).unwrap(),
+    );
+    assert!(
+        a.get("load_factor_tolerance").is_none(),
+        "absent when exact"
+    );
+    assert_eq!(b["load_factor_tolerance"], 0.05);
+    assert_eq!(a["per_step"], b["per_step"]);
+}
