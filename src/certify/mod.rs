@@ -56,8 +56,8 @@ pub struct Options {
     /// Called as each range of steps ends, with its wall time (scaling
     /// studies: where the time of a parallel run went).
     pub range_done: Option<fn(&RangeDone)>,
-    /// How far below the exact smallest load factor of a step's poses the
-    /// reported one may lie (0: exact; see
+    /// How far above the exact smallest load factor of a step's poses the
+    /// reported one may lie, as a fraction of it (0: exact; see
     /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`]).
     pub load_factor_tolerance: f64,
 }

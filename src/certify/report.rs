@@ -191,8 +191,9 @@ pub struct Report {
     pub moves: usize,
     /// Names of the checks that were run.
     pub checks: Vec<String>,
-    /// How far below the exact smallest load factor of a step's poses the
-    /// reported ones may lie (`--load-factor-tolerance`); absent when exact.
+    /// How far above the exact smallest load factor of a step's poses the
+    /// reported ones may lie, as a fraction of them
+    /// (`--load-factor-tolerance`); absent when exact.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub load_factor_tolerance: f64,
     pub certified: bool,
@@ -308,7 +309,7 @@ impl Report {
         if self.load_factor_tolerance > 0.0 {
             let _ = writeln!(
                 s,
-                "load factors within {} of the exact ones (--load-factor-tolerance); verdicts exact",
+                "load factors: each exact one is at least (1 − {}) × the reported one (--load-factor-tolerance); verdicts exact",
                 self.load_factor_tolerance
             );
         }

@@ -52,9 +52,10 @@ pub struct ReportArgs {
     /// a 3D replay of the schedule with its findings (no network needed).
     #[arg(long, value_name = "REPORT.html")]
     html: Option<std::path::PathBuf>,
-    /// Report each step's limit-analysis load factor within this fraction
-    /// of the exact one, in [0, 0.5): poses whose factor is bounded from a
-    /// solved neighbour are not solved. Verdicts stay exact. 0 is exact.
+    /// Let each step's reported limit-analysis load factor exceed the exact
+    /// one by this fraction of itself, in [0, 0.5): poses whose factor is
+    /// bounded from a solved neighbour are not solved. Verdicts stay exact.
+    /// 0 is exact.
     #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
     load_factor_tolerance: f64,
 }

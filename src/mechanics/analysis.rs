@@ -190,13 +190,13 @@ pub struct Settings {
     /// corner forces too ([`corner_ratio`]). Off only to measure what the
     /// gate changes.
     pub corner_gate: bool,
-    /// How far below the exact smallest load factor of a step's poses the
-    /// reported one may lie, as a fraction (0: exact, every pose the
+    /// How far above the exact smallest load factor of a step's poses the
+    /// reported one may lie, as a fraction of the reported one (0: exact, every pose the
     /// screen could not clear solved). Above 0, a pose whose factor is
     /// bounded from the nearest solved pose's equilibrium
     /// ([`limit::bound_from`]) at ≥ 1 and ≥ (1 − tolerance) × the smallest
     /// found is not solved: verdicts stay exact (a skipped pose holds),
-    /// the factor is within the tolerance.
+    /// the exact factor is at least (1 − tolerance) × the reported one.
     pub load_factor_tolerance: f64,
 }
 
