@@ -394,8 +394,15 @@ impl Ranges<'_> {
     /// The range handed out `k`-th: the last first, since structures grow
     /// over a schedule and late ranges cost the most; the cheap early ones
     /// then fill the gaps at the end (longest job first balances workers).
-    pub fn in_handout_order(&self, k: usize) -> usize {
+    fn in_handout_order(&self, k: usize) -> usize {
         self.count() - 1 - k
+    }
+
+    /// The next range to hand out, counted by `handed` (shared by whoever
+    /// hands them out), or `None` once all are.
+    pub fn next_from(&self, handed: &std::sync::atomic::AtomicUsize) -> Option<usize> {
+        let k = handed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        (k < self.count()).then(|| self.in_handout_order(k))
     }
 
     /// Runs ranges on this process's threads, each thread taking the next
@@ -470,17 +477,13 @@ pub trait RangeRunner {
 }
 
 /// Runs the ranges on this process's threads (rayon), handed out from a
-/// shared counter in [`Ranges::in_handout_order`].
+/// shared counter ([`Ranges::next_from`]).
 pub struct Threads;
 
 impl RangeRunner for Threads {
     fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        let n = ranges.count();
-        ranges.pull(&|| {
-            let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            (k < n).then(|| ranges.in_handout_order(k))
-        })
+        let handed = std::sync::atomic::AtomicUsize::new(0);
+        ranges.pull(&|| ranges.next_from(&handed))
     }
 }
 

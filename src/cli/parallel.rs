@@ -159,13 +159,10 @@ mod mpi_session {
             // Rank 0's own threads take ranges from the counter; the
             // dispatcher alone talks to the other ranks (answers and
             // parts), so MPI is never called from two threads at once here.
-            let next = AtomicUsize::new(0);
+            let handed = AtomicUsize::new(0);
             std::thread::scope(|s| {
-                let dispatcher = s.spawn(|| serve(n, ranges, &next));
-                let mine = ranges.pull(&|| {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    (k < n).then(|| ranges.in_handout_order(k))
-                });
+                let dispatcher = s.spawn(|| serve(ranges, &handed));
+                let mine = ranges.pull(&|| ranges.next_from(&handed));
                 let parts = dispatcher.join().expect("the dispatcher does not panic");
                 combine(mine.map_err(|e| e.to_string()), parts)
             })
@@ -191,7 +188,7 @@ mod mpi_session {
     /// and collects the other ranks' parts, until it has them all. It
     /// polls, sleeping between empty polls, so that it does not take a
     /// core from the ranges.
-    fn serve(n: usize, ranges: &Ranges<'_>, next: &AtomicUsize) -> Vec<(i32, Vec<u8>)> {
+    fn serve(ranges: &Ranges<'_>, handed: &AtomicUsize) -> Vec<(i32, Vec<u8>)> {
         let world = comm();
         let mut parts = Vec::new();
         while parts.len() + 1 < world.size() as usize {
@@ -207,12 +204,7 @@ mod mpi_session {
                 continue;
             }
             let _: (u8, _) = msg.matched_receive();
-            let k = next.fetch_add(1, Ordering::Relaxed);
-            let answer = if k < n {
-                ranges.in_handout_order(k) as i64
-            } else {
-                -1
-            };
+            let answer = ranges.next_from(handed).map_or(-1, |i| i as i64);
             world
                 .process_at_rank(status.source_rank())
                 .send_with_tag(&answer, GIVE);

@@ -1017,13 +1017,13 @@ impl Analyzer {
                     .par_iter()
                     .map(|&(pose, _)| {
                         let loads = body_loads(s, pose);
-                        limit::load_factor_with_field(
-                            s,
-                            &self.model,
-                            &loads,
-                            part,
-                            Connectors::Capacities,
-                        )
+                        let (model, c) = (&self.model, Connectors::Capacities);
+                        // Equilibria are kept only to bound later poses.
+                        if tolerance > 0.0 {
+                            limit::load_factor_with_field(s, model, &loads, part, c)
+                        } else {
+                            (limit::load_factor(s, model, &loads, part, c), None)
+                        }
                     })
                     .collect();
                 for (slot, r) in solved[i..end].iter_mut().zip(results) {
@@ -1038,7 +1038,7 @@ impl Analyzer {
             let (cap, field) = solved[i]
                 .take()
                 .expect("solved in this wave or an earlier one");
-            if let (Some(f), true) = (field, tolerance > 0.0) {
+            if let Some(f) = field {
                 fields.push((pose, f));
             }
             out.runs += 1;

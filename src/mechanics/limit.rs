@@ -82,7 +82,7 @@ pub fn load_factor(
     part: Part<'_>,
     which: Connectors,
 ) -> LimitResult {
-    load_factor_with_field(s, model, loads, part, which).0
+    solve(s, model, loads, part, which, false).0
 }
 
 /// An admissible equilibrium found by the limit analysis: the corner
@@ -107,15 +107,18 @@ pub fn load_factor_with_field(
     part: Part<'_>,
     which: Connectors,
 ) -> (LimitResult, Option<Field>) {
-    let nb = s.bodies.len();
-    // Equation groups: with capacities, every free body of the part is
-    // balanced on its own (moments about its centre); with rigid
-    // connectors the part is one rigid body (moments about its first
-    // body's centre) and only its supports carry unknowns — the connected
-    // internal links can transmit any resultant, so any balance of the
-    // whole extends to every body through a spanning tree.
-    let rigid = which == Connectors::Rigid;
-    let mut row_of = vec![usize::MAX; nb];
+    solve(s, model, loads, part, which, true)
+}
+
+/// Where each free body's six equations start (`usize::MAX` for the
+/// others), and how many groups of six there are. With capacities, every
+/// free body of the part is balanced on its own (moments about its
+/// centre); with rigid connectors the part is one rigid body (moments
+/// about its first body's centre) and only its supports carry unknowns —
+/// the connected internal links can transmit any resultant, so any
+/// balance of the whole extends to every body through a spanning tree.
+fn equation_groups(s: &Structure, part: Part<'_>, rigid: bool) -> (Vec<usize>, usize) {
+    let mut row_of = vec![usize::MAX; s.bodies.len()];
     let mut n_groups = 0;
     for &i in part.bodies {
         if !s.bodies[i].fixed {
@@ -125,6 +128,19 @@ pub fn load_factor_with_field(
             }
         }
     }
+    (row_of, n_groups)
+}
+
+fn solve(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    which: Connectors,
+    keep_field: bool,
+) -> (LimitResult, Option<Field>) {
+    let rigid = which == Connectors::Rigid;
+    let (row_of, n_groups) = equation_groups(s, part, rigid);
     let is_free = |i: usize| row_of[i] != usize::MAX;
     let origin = |i: usize| {
         if rigid {
@@ -162,13 +178,14 @@ pub fn load_factor_with_field(
         origin: &origin,
     };
     equilibrium_rows(&mut prog, s, model, loads, part, &links, &frame);
-    let equilibrium = (!rigid).then(|| (prog.triplets.clone(), prog.rhs.len(), prog.lam));
+    let keep_field = keep_field && !rigid;
+    let equilibrium = keep_field.then(|| prog.clone());
     capacity_rows(&mut prog, s, model, &links);
     let (r, x) = maximise(prog);
-    let field = x.filter(|_| !rigid && r.lambda.is_finite() && r.lambda > 0.0);
-    let field = field.zip(equilibrium).map(|(x, (triplets, rows, lam))| {
+    let field = x.filter(|_| r.lambda.is_finite() && r.lambda > 0.0);
+    let field = field.zip(equilibrium).map(|(x, eq)| {
         let v: Vec<f64> = x.iter().map(|x| x / r.lambda).collect();
-        let residual = max_residual(&triplets, rows, lam, &v);
+        let residual = largest_residual(&eq.row_values(&v)[..eq.n_eq]);
         Field {
             links,
             x,
@@ -179,18 +196,9 @@ pub fn load_factor_with_field(
     (r, field)
 }
 
-/// The largest |row| of `A v + A_λ` over the equilibrium rows (`λ = 1`).
-fn max_residual(
-    (ri, ci, vals): &(Vec<usize>, Vec<usize>, Vec<f64>),
-    rows: usize,
-    lam: usize,
-    v: &[f64],
-) -> f64 {
-    let mut residual = vec![0.0; rows];
-    for ((&r, &c), &a) in ri.iter().zip(ci).zip(vals) {
-        residual[r] += a * if c == lam { 1.0 } else { v[c] };
-    }
-    residual.iter().fold(
+/// The largest |value| (NaN if any is).
+fn largest_residual(rows: &[f64]) -> f64 {
+    rows.iter().fold(
         0.0,
         |m: f64, r| if r.is_nan() { f64::NAN } else { m.max(r.abs()) },
     )
@@ -205,6 +213,7 @@ const CORNERS: [(f64, f64); 4] = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -
 /// The conic program being assembled: `A x + s = b`, `s` in the zero cone
 /// (equilibrium rows), the non-negative cone (capacity rows) and one
 /// second-order cone per corner; the last column is `λ`.
+#[derive(Clone)]
 struct Program {
     triplets: (Vec<usize>, Vec<usize>, Vec<f64>),
     rhs: Vec<f64>,
@@ -231,6 +240,17 @@ impl Program {
             self.triplets.1.push(c);
             self.triplets.2.push(v);
         }
+    }
+
+    /// Every row's `Σ coef·x` at `x = v` and `λ = 1`: the equilibrium
+    /// rows' residuals, then the capacity rows' left-hand sides.
+    fn row_values(&self, v: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.rhs.len()];
+        let (ri, ci, vals) = &self.triplets;
+        for ((&r, &c), &a) in ri.iter().zip(ci).zip(vals) {
+            out[r] += a * if c == self.lam { 1.0 } else { v[c] };
+        }
+        out
     }
 
     /// Appends a row `Σ coef·x ≤ b` (or `= −s` for cone rows).
@@ -409,7 +429,10 @@ fn maximise(mut prog: Program) -> (LimitResult, Option<Vec<f64>>) {
 /// of a shortest path from its body to a support; the bound is the largest
 /// multiple of it within every capacity. The candidate is checked against
 /// the equilibrium equations of `loads` before it counts: 0 (no bound)
-/// where it does not balance them to `1e-9` of the loads.
+/// where it balances them worse than the solver's own equilibrium
+/// balanced its loads. The rows are the limit analysis's own
+/// ([`equilibrium_rows`], [`capacity_rows`]), so the bound judges exactly
+/// what a solve would.
 pub fn bound_from(
     s: &Structure,
     model: &Model,
@@ -419,14 +442,7 @@ pub fn bound_from(
     extra: &[(usize, glam::DVec3)],
 ) -> f64 {
     let nb = s.bodies.len();
-    let mut row_of = vec![usize::MAX; nb];
-    let mut n_groups = 0;
-    for &i in part.bodies {
-        if !s.bodies[i].fixed {
-            row_of[i] = 6 * n_groups;
-            n_groups += 1;
-        }
-    }
+    let (row_of, n_groups) = equation_groups(s, part, false);
     let is_free = |i: usize| row_of[i] != usize::MAX;
     let mut col_of = vec![usize::MAX; s.links.len()];
     for (k, &li) in field.links.iter().enumerate() {
@@ -477,8 +493,6 @@ pub fn bound_from(
             }
         }
     }
-    // The candidate must balance `loads` (λ = 1) on every free body as
-    // well as the solver's own equilibrium balanced its loads.
     let mut prog = Program::new(6 * n_groups, PER_LINK * field.links.len());
     let origin = |i: usize| s.bodies[i].centre;
     let frame = Frame {
@@ -486,12 +500,30 @@ pub fn bound_from(
         origin: &origin,
     };
     equilibrium_rows(&mut prog, s, model, loads, part, &field.links, &frame);
-    let residual = max_residual(&prog.triplets, prog.rhs.len(), prog.lam, &v);
+    capacity_rows(&mut prog, s, model, &field.links);
+    // Each tangential bound at its least, ‖t‖.
+    for &(z, tu, tv) in &prog.socs {
+        v[z] = v[tu].hypot(v[tv]);
+    }
+    let values = prog.row_values(&v);
+    // The candidate must balance `loads` (λ = 1) on every free body as
+    // well as the solver's own equilibrium balanced its loads.
+    let residual = largest_residual(&values[..prog.n_eq]);
     let allowed = 1.01 * field.residual + 1e-12;
     if residual.partial_cmp(&allowed).is_none_or(|o| o.is_gt()) {
         return 0.0;
     }
-    largest_admissible_multiple(s, model, &field.links, &v)
+    // The largest multiple within every capacity row `lhs ≤ rhs`.
+    let mut mu = LAMBDA_CAP;
+    for (lhs, rhs) in values[prog.n_eq..].iter().zip(&prog.rhs[prog.n_eq..]) {
+        if lhs.is_nan() {
+            return 0.0;
+        }
+        if *lhs > 0.0 {
+            mu = mu.min(if *rhs > 0.0 { rhs / lhs } else { 0.0 });
+        }
+    }
+    mu
 }
 
 /// The links from `body` to the nearest support (the ground, or a body
@@ -562,44 +594,6 @@ fn add_couple(cols: &mut [f64], s: &Structure, model: &Model, li: usize, m: glam
     }
 }
 
-/// The largest `μ ≤ LAMBDA_CAP` with `μ·v` within every capacity row and
-/// friction cone of `links` (tangential bounds `z` taken at `‖t‖`).
-fn largest_admissible_multiple(s: &Structure, model: &Model, links: &[usize], v: &[f64]) -> f64 {
-    let w = model.weight();
-    let mut mu = LAMBDA_CAP;
-    let mut limit = |lhs: f64, rhs: f64| {
-        if lhs > 0.0 {
-            mu = mu.min(if rhs > 0.0 { rhs / lhs } else { 0.0 });
-        } else if lhs.is_nan() {
-            mu = 0.0;
-        }
-    };
-    for (k, &li) in links.iter().enumerate() {
-        let cap = capacity(s, model, li);
-        let p = cap.tension() / w / 4.0;
-        let n = |ki: usize| v[PER_LINK * k + PER_CORNER * ki];
-        match cap.bending {
-            Bending::RigidHinge => (0..4).for_each(|ki| limit(n(ki), p)),
-            Bending::Elastic => {
-                for (eu, ev) in CORNERS {
-                    let lhs: f64 = CORNERS
-                        .iter()
-                        .enumerate()
-                        .map(|(ki, (su, sv))| (1.0 + 3.0 * (eu * su + ev * sv)) * n(ki))
-                        .sum();
-                    limit(lhs, 4.0 * p);
-                }
-            }
-        }
-        for ki in 0..4 {
-            let col = PER_LINK * k + PER_CORNER * ki;
-            let z = (v[col + 1] * v[col + 1] + v[col + 2] * v[col + 2]).sqrt();
-            limit(cap.friction * n(ki) + z, cap.friction * p);
-        }
-    }
-    mu
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -645,7 +639,7 @@ mod tests {
         ];
         for body in bodies.iter().copied().filter(|&b| !s.bodies[b].fixed) {
             for dir in dirs {
-                for size in [0.01, 0.1, 0.5] {
+                for size in [0.01, 0.1, 0.5, 5.0, 20.0] {
                     let m = dir.normalize() * size;
                     let loads = with_moment(&base, body, m);
                     let bound = bound_from(s, model, &loads, part, &field, &[(body, m)]);
