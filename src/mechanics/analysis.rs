@@ -976,7 +976,8 @@ impl Analyzer {
         // The poses' problems are independent: past the first (a failing
         // step usually fails there), they are solved in waves of as many
         // as there are threads, ahead of the sequential logic below, which
-        // alone decides what counts, so results do not depend on threads.
+        // alone decides what counts and, with a tolerance, which poses a
+        // solved one spares: results do not depend on threads.
         let mut solved: Vec<Option<(limit::LimitResult, Option<limit::Field>)>> =
             failing.iter().map(|_| None).collect();
         let tolerance = self.settings.load_factor_tolerance;
@@ -1012,11 +1013,31 @@ impl Analyzer {
                 continue;
             }
             if solved[i].is_none() {
-                let end = (i + wave).min(failing.len());
-                let results: Vec<_> = failing[i..end]
+                // This pose and, ahead of the logic, the next ones still
+                // unsolved that the fields known now do not spare (with a
+                // tolerance, the field solved here may spare some of them
+                // after all: that work is then wasted, never counted).
+                let mut ahead = vec![i];
+                for (j, &(p, _)) in failing.iter().enumerate().skip(i + 1) {
+                    if ahead.len() >= wave {
+                        break;
+                    }
+                    let known = solved[j].is_some()
+                        || (tolerance > 0.0
+                            && !fields.is_empty()
+                            && spared(
+                                self.pose_bound(s, part, &fields, p),
+                                out.capacities,
+                                tolerance,
+                            ));
+                    if !known {
+                        ahead.push(j);
+                    }
+                }
+                let results: Vec<_> = ahead
                     .par_iter()
-                    .map(|&(pose, _)| {
-                        let loads = body_loads(s, pose);
+                    .map(|&j| {
+                        let loads = body_loads(s, failing[j].0);
                         let (model, c) = (&self.model, Connectors::Capacities);
                         // Equilibria are kept only to bound later poses.
                         if tolerance > 0.0 {
@@ -1026,14 +1047,10 @@ impl Analyzer {
                         }
                     })
                     .collect();
-                for (slot, r) in solved[i..end].iter_mut().zip(results) {
-                    *slot = Some(r);
+                for (&j, r) in ahead.iter().zip(results) {
+                    solved[j] = Some(r);
                 }
-                // With a tolerance, poses are judged one by one: a solved
-                // pose may spare the next ones.
-                if tolerance == 0.0 {
-                    wave = rayon::current_num_threads().max(1);
-                }
+                wave = rayon::current_num_threads().max(1);
             }
             let (cap, field) = solved[i]
                 .take()

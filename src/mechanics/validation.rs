@@ -606,3 +606,69 @@ fn the_actuator_hold_is_reported_apart_from_the_connectors() {
     assert_eq!(c.critical, Some(super::analysis::Critical::Pivot(0)));
     assert!((c.hold_utilisation - 2.0).abs() < 1e-9);
 }
+
+/// A cantilever two modules high from one fixed root, `n` long, with a
+/// mover swinging on its upper tip towards `to` (`mirror`: the image in
+/// y = 0): it holds only through the limit analysis at every pose.
+fn deep_swing(n: i32, to: Cell, mirror: bool) -> Structure {
+    let flip = |c: Cell| if mirror { Cell::new(c.x, -c.y, c.z) } else { c };
+    let mut cells: Vec<Cell> = (0..2)
+        .flat_map(|z| (0..=n).map(move |x| Cell::new(x, 0, z)))
+        .collect();
+    let (pivot, from) = (Cell::new(n, 0, 1), Cell::new(n + 1, 0, 1));
+    cells.push(from);
+    let mover: MoverSpec = (
+        cells.len() as ModuleId,
+        Some(2 * n as ModuleId + 2),
+        Motion::Rotate {
+            from: flip(from),
+            to: flip(to),
+            pivot: flip(pivot),
+            route: Route::Octagonal,
+        },
+    );
+    let cells: Vec<Cell> = cells.into_iter().map(flip).collect();
+    structure(&FccLattice, None, &cells, &[0], &[mover])
+}
+
+#[test]
+fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
+    let model = Model::default_catom();
+    let tau = 0.05;
+    let on = |threads: usize, s: &Structure, tolerance: f64| {
+        let mut a = Analyzer::new(model.clone(), false);
+        a.settings.load_factor_tolerance = tolerance;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| a.analyse(s))
+    };
+    for (n, to) in [(7, Cell::new(7, 1, 1)), (8, Cell::new(8, 0, 2))] {
+        for mirror in [false, true] {
+            let s = deep_swing(n, to, mirror);
+            let exact = on(1, &s, 0.0);
+            let lambda = exact.load_factor.expect("judged by the limit analysis");
+            assert!(lambda > 1.0 && exact.limit_analyses == 25, "{lambda}");
+            let spared = on(1, &s, tau);
+            let skipping = spared.load_factor.unwrap();
+            assert_eq!(spared.verdict(), exact.verdict());
+            assert!(spared.limit_analyses < exact.limit_analyses / 2);
+            // The reported factor is at most 1/(1 − τ) above the exact one,
+            // never below it.
+            assert!(skipping >= lambda * (1.0 - 1e-9), "{skipping} < {lambda}");
+            assert!(
+                skipping * (1.0 - tau) <= lambda * (1.0 + 1e-9),
+                "{skipping} vs {lambda}"
+            );
+            // Waves of poses solved ahead on idle threads change nothing.
+            for threads in [3] {
+                let t = on(threads, &s, tau);
+                assert_eq!(t.load_factor.map(f64::to_bits), Some(skipping.to_bits()));
+                assert_eq!(t.limit_analyses, spared.limit_analyses);
+                let e = on(threads, &s, 0.0);
+                assert_eq!(e.load_factor.map(f64::to_bits), Some(lambda.to_bits()));
+            }
+        }
+    }
+}
