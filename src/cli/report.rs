@@ -58,6 +58,13 @@ pub struct ReportArgs {
     /// 0 is exact.
     #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
     load_factor_tolerance: f64,
+    /// Steps per range of the mechanics, which ranges run in parallel
+    /// (default: about 64 ranges of at least 16 steps). Shorter ranges
+    /// spread a run of costly steps over more threads; each range starts
+    /// its elastic solves afresh, so figures may differ from the default's
+    /// in their last digits, never with the thread count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    range_steps: Option<u32>,
 }
 
 impl ReportArgs {
@@ -84,7 +91,7 @@ impl ReportArgs {
             lattice_only: self.lattice_only,
             model: self.model.clone(),
             base_dir: origin.parent().map(Path::to_path_buf),
-            range_steps: None,
+            range_steps: self.range_steps.map(|n| n as usize),
             range_done: std::env::var_os("RECONFCHECK_RANGE_TIMES")
                 .is_some()
                 .then_some(print_range_time),

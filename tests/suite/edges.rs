@@ -331,3 +331,55 @@ fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
     assert_eq!(b["load_factor_tolerance"], 0.05);
     assert_eq!(a["per_step"], b["per_step"]);
 }
+
+#[test]
+fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts() {
+    for n in ["0", "-3", "nan", "1.5"] {
+        let o = bin()
+            .args(["run", "--no-progress"])
+            .arg(format!("--range-steps={n}"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{n}: {err}");
+        assert!(err.contains("--range-steps"), "{n}: {err}");
+    }
+    let (default, short) = (scratch("ranges-default.json"), scratch("ranges-3.json"));
+    for (p, extra) in [(&default, None), (&short, Some("--range-steps=3"))] {
+        let o = bin()
+            .args(["run", "--no-progress", "--json"])
+            .arg(p)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let (a, b): (Value, Value) = (
+        serde_json::from_slice(&std::fs::read(&default).unwrap()).unwrap(),
+        serde_json::from_slice(&std::fs::read(&short).unwrap()).unwrap(),
+    );
+    // Every step judged, with the same findings; the utilisations agree to
+    // the solver's rounding.
+    let (sa, sb) = (
+        a["per_step"].as_array().unwrap(),
+        b["per_step"].as_array().unwrap(),
+    );
+    assert_eq!(sa.len(), sb.len());
+    for (x, y) in sa.iter().zip(sb) {
+        assert_eq!(x["violations"], y["violations"]);
+        let (u, v) = (
+            x["metrics"]["max_utilisation"].as_f64().unwrap(),
+            y["metrics"]["max_utilisation"].as_f64().unwrap(),
+        );
+        assert!(
+            (u - v).abs() <= 1e-9 * u.max(1.0),
+            "step {}: {u} vs {v}",
+            x["step"]
+        );
+    }
+}
