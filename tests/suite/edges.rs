@@ -290,6 +290,21 @@ fn model_fields_out_of_their_range_are_refused_naming_the_field() {
     }
 }
 
+/// The JSON report of `run` on the default scenario with `flags`, which
+/// must certify it.
+fn certified_default(name: &str, flags: &[&str]) -> Value {
+    let path = scratch(name);
+    let o = bin()
+        .args(["run", "--no-progress", "--json"])
+        .arg(&path)
+        .args(flags)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{flags:?}: {err}");
+    serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap()
+}
+
 #[test]
 fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
     for tol in ["nan", "inf", "-inf", "-0.01", "0.5", "1", "1e9"] {
@@ -305,25 +320,8 @@ fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
     }
     // Accepted, the report records it, and the default scenario (whose
     // steps the elastic screen clears) reads the same as the exact run.
-    let (exact, loose) = (scratch("lft-0.json"), scratch("lft-5.json"));
-    for (p, tol) in [(&exact, "0"), (&loose, "0.05")] {
-        let o = bin()
-            .args(["run", "--no-progress", "--json"])
-            .arg(p)
-            .arg(format!("--load-factor-tolerance={tol}"))
-            .output()
-            .unwrap();
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    }
-    let (a, b): (Value, Value) = (
-        serde_json::from_slice(&std::fs::read(&exact).unwrap()).unwrap(),
-        serde_json::from_slice(&std::fs::read(&loose).unwrap()).unwrap(),
-    );
+    let a = certified_default("lft-0.json", &["--load-factor-tolerance=0"]);
+    let b = certified_default("lft-5.json", &["--load-factor-tolerance=0.05"]);
     assert!(
         a.get("load_factor_tolerance").is_none(),
         "absent when exact"
@@ -344,25 +342,8 @@ fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts(
         assert_eq!(o.status.code(), Some(2), "{n}: {err}");
         assert!(err.contains("--range-steps"), "{n}: {err}");
     }
-    let (default, short) = (scratch("ranges-default.json"), scratch("ranges-3.json"));
-    for (p, extra) in [(&default, None), (&short, Some("--range-steps=3"))] {
-        let o = bin()
-            .args(["run", "--no-progress", "--json"])
-            .arg(p)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    }
-    let (a, b): (Value, Value) = (
-        serde_json::from_slice(&std::fs::read(&default).unwrap()).unwrap(),
-        serde_json::from_slice(&std::fs::read(&short).unwrap()).unwrap(),
-    );
+    let a = certified_default("ranges-default.json", &[]);
+    let b = certified_default("ranges-3.json", &["--range-steps=3"]);
     // Every step judged, with the same findings; the utilisations agree to
     // the solver's rounding.
     let (sa, sb) = (
