@@ -634,7 +634,6 @@ fn deep_swing(n: i32, to: Cell, mirror: bool) -> Structure {
 #[test]
 fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
     let model = Model::default_catom();
-    let tau = 0.05;
     let on = |threads: usize, s: &Structure, tolerance: f64| {
         let mut a = Analyzer::new(model.clone(), false);
         a.settings.load_factor_tolerance = tolerance;
@@ -644,7 +643,11 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
             .unwrap()
             .install(|| a.analyse(s))
     };
-    for (n, to) in [(7, Cell::new(7, 1, 1)), (8, Cell::new(8, 0, 2))] {
+    // τ = 0.01 solves several poses per step, so which poses a solved
+    // field spares matters: counting fields of poses solved ahead before
+    // the sequential logic reaches them fails here.
+    let cases = [(7, Cell::new(7, 1, 1)), (8, Cell::new(8, 0, 2))];
+    for ((n, to), tau) in cases.into_iter().flat_map(|c| [(c, 0.05), (c, 0.01)]) {
         for mirror in [false, true] {
             let s = deep_swing(n, to, mirror);
             let exact = on(1, &s, 0.0);
@@ -662,13 +665,11 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
                 "{skipping} vs {lambda}"
             );
             // Waves of poses solved ahead on idle threads change nothing.
-            for threads in [3] {
-                let t = on(threads, &s, tau);
-                assert_eq!(t.load_factor.map(f64::to_bits), Some(skipping.to_bits()));
-                assert_eq!(t.limit_analyses, spared.limit_analyses);
-                let e = on(threads, &s, 0.0);
-                assert_eq!(e.load_factor.map(f64::to_bits), Some(lambda.to_bits()));
-            }
+            let t = on(3, &s, tau);
+            assert_eq!(t.load_factor.map(f64::to_bits), Some(skipping.to_bits()));
+            assert_eq!(t.limit_analyses, spared.limit_analyses);
+            let e = on(3, &s, 0.0);
+            assert_eq!(e.load_factor.map(f64::to_bits), Some(lambda.to_bits()));
         }
     }
 }
