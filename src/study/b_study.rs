@@ -699,7 +699,7 @@ mod tests {
         // At b = 7 the 2-tile cube holds (its worst connectors lie in the
         // ground-tile layer and its tilted branches); with a second tile
         // layer the connectors of the upper tiles are overloaded: the
-        // shape's size lowers b_max (8 → 6, docs/mechanics.md).
+        // shape's size lowers b_max (8 → 5, docs/mechanics.md).
         let model = Model::default_catom();
         let two = b_study(
             "cube",
