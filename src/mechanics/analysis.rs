@@ -1002,14 +1002,7 @@ impl Analyzer {
                 }
                 continue;
             }
-            if tolerance > 0.0
-                && !fields.is_empty()
-                && spared(
-                    self.pose_bound(s, part, &fields, pose),
-                    out.capacities,
-                    tolerance,
-                )
-            {
+            if self.spared_by(s, part, &fields, pose, out.capacities) {
                 continue;
             }
             if solved[i].is_none() {
@@ -1022,14 +1015,8 @@ impl Analyzer {
                     if ahead.len() >= wave {
                         break;
                     }
-                    let known = solved[j].is_some()
-                        || (tolerance > 0.0
-                            && !fields.is_empty()
-                            && spared(
-                                self.pose_bound(s, part, &fields, p),
-                                out.capacities,
-                                tolerance,
-                            ));
+                    let known =
+                        solved[j].is_some() || self.spared_by(s, part, &fields, p, out.capacities);
                     if !known {
                         ahead.push(j);
                     }
@@ -1063,6 +1050,23 @@ impl Analyzer {
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
         out
+    }
+
+    /// Whether the fields solved so far prove that `pose` holds within the
+    /// tolerance of `smallest` ([`spared`]); never when exact or before a
+    /// field is known (no bound is built then).
+    fn spared_by(
+        &self,
+        s: &Structure,
+        part: limit::Part<'_>,
+        fields: &[(Option<usize>, limit::Field)],
+        pose: Option<usize>,
+        smallest: f64,
+    ) -> bool {
+        let tolerance = self.settings.load_factor_tolerance;
+        tolerance > 0.0
+            && !fields.is_empty()
+            && spared(self.pose_bound(s, part, fields, pose), smallest, tolerance)
     }
 
     /// A lower bound of the load factor at `pose` from the equilibrium of

@@ -290,6 +290,22 @@ fn model_fields_out_of_their_range_are_refused_naming_the_field() {
     }
 }
 
+/// `run` on the default scenario with `flag` at each of `values`: exit 2,
+/// the flag named, nothing certified.
+fn refused_on_default(flag: &str, values: &[&str]) {
+    for v in values {
+        let o = bin()
+            .args(["run", "--no-progress"])
+            .arg(format!("{flag}={v}"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{v}: {err}");
+        assert!(err.contains(flag), "{v}: {err}");
+        assert!(o.stdout.is_empty(), "{v}: nothing certified");
+    }
+}
+
 /// The JSON report of `run` on the default scenario with `flags`, which
 /// must certify it.
 fn certified_default(name: &str, flags: &[&str]) -> Value {
@@ -307,17 +323,10 @@ fn certified_default(name: &str, flags: &[&str]) -> Value {
 
 #[test]
 fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
-    for tol in ["nan", "inf", "-inf", "-0.01", "0.5", "1", "1e9"] {
-        let o = bin()
-            .args(["run", "--no-progress"])
-            .arg(format!("--load-factor-tolerance={tol}"))
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{tol}: {err}");
-        assert!(err.contains("--load-factor-tolerance"), "{tol}: {err}");
-        assert!(o.stdout.is_empty(), "{tol}: nothing certified");
-    }
+    refused_on_default(
+        "--load-factor-tolerance",
+        &["nan", "inf", "-inf", "-0.01", "0.5", "1", "1e9"],
+    );
     // Accepted, the report records it, and the default scenario (whose
     // steps the elastic screen clears) reads the same as the exact run.
     let a = certified_default("lft-0.json", &["--load-factor-tolerance=0"]);
@@ -332,16 +341,7 @@ fn a_load_factor_tolerance_outside_0_to_one_half_is_refused_naming_the_flag() {
 
 #[test]
 fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts() {
-    for n in ["0", "-3", "nan", "1.5"] {
-        let o = bin()
-            .args(["run", "--no-progress"])
-            .arg(format!("--range-steps={n}"))
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{n}: {err}");
-        assert!(err.contains("--range-steps"), "{n}: {err}");
-    }
+    refused_on_default("--range-steps", &["0", "-3", "nan", "1.5"]);
     let a = certified_default("ranges-default.json", &[]);
     let b = certified_default("ranges-3.json", &["--range-steps=3"]);
     // Every step judged, with the same findings; the utilisations agree to
