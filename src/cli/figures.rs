@@ -2,6 +2,7 @@
 //! our runs beside the published numbers, drawn and printed as a table.
 
 use reconfcheck::algorithms;
+use reconfcheck::algorithms::scaffold::feed::Feed;
 use reconfcheck::algorithms::scaffold::paper::Protocol;
 use reconfcheck::error::{Error, InputError};
 use reconfcheck::render;
@@ -18,6 +19,7 @@ pub struct Figure {
     pub scenarios: Vec<PathBuf>,
     pub output: PathBuf,
     pub progress: bool,
+    pub feed: Feed,
 }
 
 /// Parses `A..B` or `A,B,…` (sizes 2 to 9: the authors' targets).
@@ -45,7 +47,14 @@ pub fn draw(f: Figure) -> Result<u8, Error> {
     let both = [Protocol::Paper, Protocol::Safe];
     match f.number {
         11..=13 => {
-            let runs = figs::sweep(&Family::CANONICAL, &f.sizes, &both, &f.shapes, &progress)?;
+            let runs = figs::sweep(
+                &Family::CANONICAL,
+                &f.sizes,
+                &both,
+                f.feed,
+                &f.shapes,
+                &progress,
+            )?;
             print!("{}", figs::table(&runs));
             let metric = match f.number {
                 11 => Metric::Steps,
@@ -55,7 +64,14 @@ pub fn draw(f: Figure) -> Result<u8, Error> {
             render::scaffold_figures::draw(&runs, metric, &f.output)?;
         }
         14 => {
-            let runs = figs::sweep(&Family::CANONICAL, &[6], &both, &f.shapes, &progress)?;
+            let runs = figs::sweep(
+                &Family::CANONICAL,
+                &[6],
+                &both,
+                f.feed,
+                &f.shapes,
+                &progress,
+            )?;
             print!("{}", figs::table(&runs));
             let curves = paper_curves(&runs);
             let marks: Vec<(String, f64)> = [Family::Pyramid, Family::Cube]
@@ -77,6 +93,7 @@ pub fn draw(f: Figure) -> Result<u8, Error> {
                 &[Family::Cylinder, Family::StackedCylinder],
                 &[6],
                 &[Protocol::Paper],
+                f.feed,
                 &f.shapes,
                 &progress,
             )?;
@@ -100,6 +117,7 @@ pub fn draw(f: Figure) -> Result<u8, Error> {
         16 => {
             let scenarios = if f.scenarios.is_empty() {
                 vec![
+                    PathBuf::from("scenarios/sandcastle-eager.toml"),
                     PathBuf::from("scenarios/sandcastle-paper.toml"),
                     PathBuf::from("scenarios/sandcastle.toml"),
                 ]

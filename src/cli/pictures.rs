@@ -2,6 +2,7 @@
 //! (modules placed per step) and `loadmap` (connector utilisation).
 
 use reconfcheck::algorithms;
+use reconfcheck::algorithms::scaffold::feed::Feed;
 use reconfcheck::certify::{self, Options};
 use reconfcheck::error::{Error, InputError};
 use reconfcheck::mechanics::Model;
@@ -41,6 +42,10 @@ pub fn render(a: RenderArgs) -> Result<u8, Error> {
     Ok(0)
 }
 
+fn parse_feed(s: &str) -> Result<Feed, String> {
+    Feed::parse(s).ok_or_else(|| format!("'{s}' is not a feed (known: just-in-time, eager)"))
+}
+
 #[derive(clap::Args)]
 pub struct PlotArgs {
     /// Scenarios whose placement curves to draw (with `--figure 16`, the
@@ -62,6 +67,11 @@ pub struct PlotArgs {
     /// Folder of the authors' canonical targets.
     #[arg(long, value_name = "DIR")]
     shapes: Option<PathBuf>,
+    /// When the sandbox releases modules, for Figs. 11–15 (Fig. 16 takes
+    /// it from each scenario): `just-in-time` or `eager` (the authors'
+    /// feeding; see docs/scaffold.md).
+    #[arg(long, default_value = "just-in-time", value_parser = parse_feed)]
+    feed: Feed,
     /// Never show a progress bar.
     #[arg(long)]
     no_progress: bool,
@@ -76,6 +86,7 @@ pub fn plot(a: PlotArgs) -> Result<u8, Error> {
             scenarios: a.scenarios,
             output: a.output,
             progress: !a.no_progress,
+            feed: a.feed,
         });
     }
     let mut curves = Vec::new();

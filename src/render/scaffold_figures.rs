@@ -48,6 +48,18 @@ impl Metric {
     }
 }
 
+/// The title's note of the feed, when it is not the default for every run.
+fn feeds(runs: &[Run]) -> String {
+    use crate::algorithms::scaffold::feed::Feed;
+    let mut names: Vec<&str> = runs.iter().map(|r| r.feed.name()).collect();
+    names.dedup();
+    if runs.iter().all(|r| r.feed == Feed::JustInTime) {
+        String::new()
+    } else {
+        format!(", feed {}", names.join(" / "))
+    }
+}
+
 fn colour(f: Family) -> RGBColor {
     match f {
         Family::HalfSphere => RGBColor(0, 140, 0),
@@ -83,7 +95,7 @@ pub fn draw(runs: &[Run], metric: Metric, path: &Path) -> Result<(), Error> {
             * 1.1;
         let mut c = ChartBuilder::on(&root)
             .caption(
-                format!("{} (seed 000, b = 6)", metric.caption()),
+                format!("{} (seed 000, b = 6{})", metric.caption(), feeds(runs)),
                 ("sans-serif", 18),
             )
             .margin(12)

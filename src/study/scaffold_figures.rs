@@ -8,8 +8,9 @@
 //! module counts are theirs: the cube of size N has exactly the modules of
 //! their `results/main.dat`. The pyramid is §4's h-pyramid with h = N.
 
+use crate::algorithms::scaffold::feed::Feed;
 use crate::algorithms::scaffold::paper::Protocol;
-use crate::algorithms::scaffold::{ShapeSpec, scaffold_schedule_with};
+use crate::algorithms::scaffold::{ShapeSpec, scaffold_schedule_fed};
 use crate::error::InputError;
 use crate::progress::Reporter;
 use crate::schedule::{Event, Schedule};
@@ -78,6 +79,7 @@ pub struct Run {
     pub family: Family,
     pub size: u32,
     pub protocol: Protocol,
+    pub feed: Feed,
     pub steps: usize,
     pub modules: usize,
     /// Tile layers of the scaffold: Fig. 12's "height levels".
@@ -119,15 +121,16 @@ pub fn placed_per_step(s: &Schedule) -> Vec<usize> {
     out
 }
 
-/// Generates one shape in one protocol and takes its figures.
+/// Generates one shape in one protocol and feed, and takes its figures.
 pub fn run(
     family: Family,
     size: u32,
     protocol: Protocol,
+    feed: Feed,
     shapes: &Path,
 ) -> Result<Run, InputError> {
     let spec = family.spec(size, shapes)?;
-    let s = scaffold_schedule_with(&spec, B, protocol)?;
+    let s = scaffold_schedule_fed(&spec, B, protocol, feed)?;
     let meta = |k: &str| s.meta.get(k).and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     let top_root = s
         .meta
@@ -140,6 +143,7 @@ pub fn run(
         family,
         size,
         protocol,
+        feed,
         steps: s.steps.len(),
         modules: meta("scaffold_modules"),
         levels: meta("tile_layers"),
@@ -148,11 +152,12 @@ pub fn run(
     })
 }
 
-/// Every family × size × protocol, in that order.
+/// Every family × size × protocol, in that order, all with one feed.
 pub fn sweep(
     families: &[Family],
     sizes: &[u32],
     protocols: &[Protocol],
+    feed: Feed,
     shapes: &Path,
     progress: &Reporter,
 ) -> Result<Vec<Run>, InputError> {
@@ -162,7 +167,7 @@ pub fn sweep(
     for &f in families {
         for &n in sizes {
             for &p in protocols {
-                out.push(run(f, n, p, shapes)?);
+                out.push(run(f, n, p, feed, shapes)?);
                 progress.advance(1);
             }
         }
@@ -248,7 +253,7 @@ pub fn default_shapes() -> PathBuf {
 pub fn table(runs: &[Run]) -> String {
     use std::fmt::Write;
     let mut s = String::from(
-        "shape             size protocol  modules  steps  levels  steps/level  modules/step  top root  published (steps, modules)\n",
+        "shape             size protocol feed          modules  steps  levels  steps/level  modules/step  top root  published (steps, modules)\n",
     );
     for r in runs {
         let published = published::point(r.family, r.size)
@@ -262,10 +267,11 @@ pub fn table(runs: &[Run]) -> String {
             .unwrap_or_else(|| "—".into());
         let _ = writeln!(
             s,
-            "{:<17} {:>4} {:<8} {:>8} {:>6} {:>7} {:>12.1} {:>13.2} {:>9}  {}",
+            "{:<17} {:>4} {:<8} {:<12} {:>8} {:>6} {:>7} {:>12.1} {:>13.2} {:>9}  {}",
             r.family.name(),
             r.size,
             r.protocol.name(),
+            r.feed.name(),
             r.modules,
             r.steps,
             r.levels,
@@ -292,6 +298,7 @@ mod tests {
             &[Family::Pyramid, Family::Cube],
             &[2, 3],
             &[Protocol::Paper],
+            Feed::JustInTime,
             &shapes(),
             &Reporter::silent(),
         )

@@ -681,7 +681,8 @@ fn plot_figure_12_draws_the_canonical_shapes_beside_the_published_points() {
     // Eq. 6 and the cube beside the authors' run (their module counts).
     assert_eq!(table.lines().count(), 1 + 4 * 2 * 2, "{table}");
     assert!(
-        table.contains("pyramid              2 paper          65") && table.contains("80 ("),
+        table.contains("pyramid              2 paper    just-in-time       65")
+            && table.contains("80 ("),
         "{table}"
     );
     assert!(
@@ -690,6 +691,19 @@ fn plot_figure_12_draws_the_canonical_shapes_beside_the_published_points() {
     );
     let png = std::fs::read(&out).unwrap();
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+    // The authors' feeding, on request: every run says so.
+    let eager = succeed(
+        bin()
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["plot", "--figure", "12", "--sizes", "2", "--feed", "eager"])
+            .args(["--no-progress", "-o"])
+            .arg(&out),
+    );
+    assert_eq!(eager.lines().count(), 1 + 4 * 2, "{eager}");
+    assert!(
+        eager.lines().skip(1).all(|l| l.contains(" eager ")),
+        "{eager}"
+    );
 }
 
 #[test]
@@ -698,6 +712,7 @@ fn plot_refuses_an_unknown_figure_and_sizes_outside_the_authors_targets() {
         vec!["--figure", "10"],
         vec!["--figure", "11", "--sizes", "1..12"],
         vec!["--figure", "11", "--sizes", "two"],
+        vec!["--figure", "11", "--feed", "flood"],
     ] {
         let o = bin()
             .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -709,6 +724,9 @@ fn plot_refuses_an_unknown_figure_and_sizes_outside_the_authors_targets() {
             .unwrap();
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         let e = stderr(&o);
-        assert!(e.contains("--figure") || e.contains("--sizes"), "{e}");
+        assert!(
+            e.contains("--figure") || e.contains("--sizes") || e.contains("--feed"),
+            "{e}"
+        );
     }
 }

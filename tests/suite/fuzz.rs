@@ -305,6 +305,10 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
             "shape = \"pyramid\"\nh = 1\nb = 4\nprotocol = \"paper\"",
         ),
         (
+            "scaffold",
+            "shape = \"pyramid\"\nh = 2\nb = 4\nfeed = \"eager\"",
+        ),
+        (
             "active-subtraction",
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),

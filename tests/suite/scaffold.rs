@@ -331,7 +331,7 @@ fn dense_b4_cubes_are_refused_up_front_naming_the_parameters() {
 #[test]
 #[ignore]
 fn protocol_study() {
-    use reconfcheck::algorithms::scaffold::paper::Protocol;
+    use reconfcheck::algorithms::scaffold::{feed::Feed, paper::Protocol, scaffold_schedule_fed};
     let names = std::env::var("SHAPES").unwrap_or_else(|_| "pyramid2,pyramid3".into());
     for name in names.split(',') {
         let spec = match name.strip_prefix("pyramid") {
@@ -340,10 +340,14 @@ fn protocol_study() {
             },
             None => shape(&format!("{name}.csg")),
         };
-        let mut line = format!("{name}:");
+        let feed = match std::env::var("FEED") {
+            Ok(f) => Feed::parse(&f).expect("FEED is just-in-time or eager"),
+            Err(_) => Feed::JustInTime,
+        };
+        let mut line = format!("{name} ({}):", feed.name());
         for protocol in [Protocol::Safe, Protocol::Paper] {
             let t = std::time::Instant::now();
-            let s = scaffold_schedule_with(&spec, 6, protocol).unwrap();
+            let s = scaffold_schedule_fed(&spec, 6, protocol, feed).unwrap();
             let gen_s = t.elapsed().as_secs_f64();
             line += &format!(
                 " {} {} steps ({} modules, {gen_s:.1} s)",
@@ -377,22 +381,57 @@ fn protocol_study() {
 }
 
 #[test]
-fn an_unknown_protocol_is_refused_naming_the_scenario_and_the_parameter() {
+fn an_unknown_protocol_or_feed_is_refused_naming_the_scenario_and_the_parameter() {
     let dir = common::scratch_dir("scaffold-protocol");
-    let p = dir.join("bad.toml");
-    std::fs::write(
-        &p,
-        "name = \"bad\"\nalgorithm = \"scaffold\"\n[parameters]\nshape = \"pyramid\"\nh = 2\nprotocol = \"lights\"\n",
-    )
-    .unwrap();
-    let sc = reconfcheck::scenario::Scenario::load(&p).unwrap();
-    let e = reconfcheck::algorithms::generate(&sc).unwrap_err();
-    assert!(
-        e.message.contains("protocol") && e.message.contains("'lights'"),
-        "{}",
-        e.message
-    );
-    assert_eq!(e.file.as_deref(), Some(p.as_path()));
+    for (param, value) in [("protocol", "lights"), ("feed", "flood"), ("feed", "")] {
+        let p = dir.join(format!("bad-{param}.toml"));
+        std::fs::write(
+            &p,
+            format!(
+                "name = \"bad\"\nalgorithm = \"scaffold\"\n[parameters]\nshape = \"pyramid\"\nh = 2\n\
+                 {param} = \"{value}\"\n"
+            ),
+        )
+        .unwrap();
+        let sc = reconfcheck::scenario::Scenario::load(&p).unwrap();
+        let e = reconfcheck::algorithms::generate(&sc).unwrap_err();
+        assert!(
+            e.message.contains(&format!("parameter {param}"))
+                && e.message.contains(&format!("'{value}'")),
+            "{}",
+            e.message
+        );
+        assert_eq!(e.file.as_deref(), Some(p.as_path()));
+    }
+}
+
+/// `feed = "eager"` (the authors' sandbox, which feeds an entry point
+/// whenever its light is green): modules leave ahead of need and wait in
+/// the structure. Faster in both protocols, and the safe protocol's
+/// schedules still certify with the exact body, without a warning.
+#[test]
+fn an_eager_feed_is_faster_in_both_protocols_and_its_safe_schedules_certify_clean() {
+    use reconfcheck::algorithms::scaffold::{feed::Feed, paper::Protocol, scaffold_schedule_fed};
+    let steps = |h, p, f| {
+        scaffold_schedule_fed(&ShapeSpec::Pyramid { h }, 6, p, f)
+            .unwrap()
+            .steps
+            .len()
+    };
+    let eager: Vec<usize> = (2..=4)
+        .map(|h| steps(h, Protocol::Paper, Feed::Eager))
+        .collect();
+    assert_eq!(eager, [59, 124, 190]);
+    for (h, &t) in (2..=4u32).zip(&eager) {
+        assert!(t < steps(h, Protocol::Paper, Feed::JustInTime), "h = {h}");
+    }
+    let shape = ShapeSpec::Pyramid { h: 3 };
+    let s = scaffold_schedule_fed(&shape, 6, Protocol::Safe, Feed::Eager).unwrap();
+    assert_eq!(s.meta["feed"], "eager");
+    assert!(s.steps.len() < scaffold_schedule(&shape, 6).unwrap().steps.len());
+    let r = certify(&s, &Options::default()).unwrap();
+    assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
+    assert!(r.certified && r.warnings.is_empty(), "{}", r.summary());
 }
 
 /// A wall on a plate: the plate's upward branches under the wall's inner

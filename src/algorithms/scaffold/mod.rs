@@ -6,12 +6,15 @@
 //! * [`polytree`] — the construction order;
 //! * [`planner`] — motion of every module from the sandbox to its cell;
 //! * [`paper`] — the paper's own motion constraint and light protocol;
+//! * [`feed`] — when modules leave the sandbox (just in time, or eagerly
+//!   as the authors' implementation feeds them);
 //! * [`plot`] — modules-placed-per-step curves (seed 000 Fig. 13–16).
 //!
 //! See `docs/scaffold.md`.
 
 pub mod csg;
 mod csg_text;
+pub mod feed;
 pub mod paper;
 pub mod planner;
 pub mod polytree;
@@ -27,6 +30,7 @@ use crate::lattice::config::{Ground, ModuleId};
 use crate::lattice::{Cell, LatticeKind};
 use crate::scenario::Scenario;
 use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
+use feed::Feed;
 use paper::Protocol;
 use rustc_hash::FxHashMap;
 use scaffold::Scaffold;
@@ -158,8 +162,19 @@ pub fn scaffold_schedule_with(
     b: u32,
     protocol: Protocol,
 ) -> Result<Schedule, InputError> {
+    scaffold_schedule_fed(shape, b, protocol, Feed::JustInTime)
+}
+
+/// [`scaffold_schedule_with`], the sandbox releasing modules as `feed`
+/// says (see [`feed`]).
+pub fn scaffold_schedule_fed(
+    shape: &ShapeSpec,
+    b: u32,
+    protocol: Protocol,
+    feed: Feed,
+) -> Result<Schedule, InputError> {
     let s = build_scaffold(shape, b)?;
-    let mut sched = schedule_for(&s, motion_rules(protocol)?, protocol)?;
+    let mut sched = schedule_for(&s, motion_rules(protocol)?, protocol, feed)?;
     sched
         .meta
         .insert("shape".into(), format!("{shape:?}").into());
@@ -171,6 +186,7 @@ pub fn schedule_for(
     s: &Scaffold,
     rules: &dyn MotionRules,
     protocol: Protocol,
+    feed: Feed,
 ) -> Result<Schedule, InputError> {
     let tree = polytree::Polytree::build_with(
         s,
@@ -199,7 +215,7 @@ pub fn schedule_for(
         .filter(|&i| missing[i] == 0)
         .map(|i| std::cmp::Reverse((0, rank[i], i)))
         .collect();
-    let mut planner = planner::Planner::new(s, rules, protocol);
+    let mut planner = planner::Planner::new(s, rules, protocol, feed);
     let mut next_id = s.sandbox.len() as ModuleId;
     let mut sources = std::collections::BTreeSet::new();
     let all_sources: Vec<(Skew, Cell)> = s
@@ -295,6 +311,7 @@ pub fn schedule_for(
     sched.meta.insert("algorithm".into(), "scaffold".into());
     sched.meta.insert("b".into(), s.b.into());
     sched.meta.insert("protocol".into(), protocol.name().into());
+    sched.meta.insert("feed".into(), feed.name().into());
     sched.meta.insert("tiles".into(), s.tiles.len().into());
     // Seed 000's Eq. 6 times the critical path: the step at which the
     // first tile root of each tile layer is in place (1-based steps).
@@ -354,6 +371,9 @@ struct Params {
     /// "safe" (default) or "paper" (see [`paper::Protocol`]).
     #[serde(default)]
     protocol: Option<String>,
+    /// "just-in-time" (default) or "eager" (see [`feed::Feed`]).
+    #[serde(default)]
+    feed: Option<String>,
 }
 
 fn default_b() -> u32 {
@@ -406,6 +426,14 @@ impl Generator for ScaffoldAssembly {
                 ))
             })?,
         };
-        scaffold_schedule_with(&spec, p.b, protocol).map_err(|e| e.in_file(&scenario.path))
+        let feed = match p.feed.as_deref() {
+            None => Feed::JustInTime,
+            Some(name) => Feed::parse(name).ok_or_else(|| {
+                scenario.error(format!(
+                    "unknown feed '{name}' in parameter feed (known: just-in-time, eager)"
+                ))
+            })?,
+        };
+        scaffold_schedule_fed(&spec, p.b, protocol, feed).map_err(|e| e.in_file(&scenario.path))
     }
 }

@@ -20,11 +20,14 @@
 //! 3. if waiting is impossible (another module comes by), its departure
 //!    is delayed by one step and it tries again. Departing after every
 //!    earlier module has arrived always succeeds, so planning terminates.
+//!    With an eager [`Feed`], a module that arrives late also tries
+//!    leaving earlier and waiting in the structure (see [`super::feed`]).
 //!
 //! The safe protocol asks exactly what the swept cells require: no gap
 //! between free agents beyond that (an earlier version kept free agents
 //! out of neighbouring cells, 13–25 % slower, see docs/scaffold.md).
 
+use super::feed::{EAGER_WINDOW, Feed};
 use super::paper::Protocol;
 use super::scaffold::Scaffold;
 use super::shape::Skew;
@@ -72,6 +75,7 @@ pub struct Hop {
 pub struct Planner<'a> {
     rules: &'a dyn MotionRules,
     protocol: Protocol,
+    feed: Feed,
     table: [[&'static [Route]; 12]; 12],
     /// Cells holding a static module once everything planned is in place.
     occupied: FxHashSet<Cell>,
@@ -104,7 +108,12 @@ pub struct Planner<'a> {
 
 impl<'a> Planner<'a> {
     /// A planner over `scaffold`'s sandbox (module ids `0..sandbox.len()`).
-    pub fn new(scaffold: &Scaffold, rules: &'a dyn MotionRules, protocol: Protocol) -> Planner<'a> {
+    pub fn new(
+        scaffold: &Scaffold,
+        rules: &'a dyn MotionRules,
+        protocol: Protocol,
+        feed: Feed,
+    ) -> Planner<'a> {
         let mut occupied = FxHashSet::default();
         let mut module_at = FxHashMap::default();
         for (i, s) in scaffold.sandbox.iter().enumerate() {
@@ -120,6 +129,7 @@ impl<'a> Planner<'a> {
         Planner {
             rules,
             protocol,
+            feed,
             table: rotation_table(),
             occupied,
             module_at,
@@ -426,12 +436,30 @@ impl<'a> Planner<'a> {
             .for_module(id)
         })?;
         let mut t0 = (ready + 1).saturating_sub(hops.len()).max(1);
-        let (cells, steps) = loop {
+        let (mut cells, mut steps) = loop {
             if let Some(found) = self.follow(t0, src, &hops, ready) {
                 break found;
             }
             t0 += 1;
         };
+        if self.feed == Feed::Eager {
+            // Leave earlier while that arrives sooner (later departures
+            // first: among equal arrivals the module holds cells least).
+            let soonest = (ready + 1).max(hops.len() + 1);
+            let mut arrival = *steps.last().unwrap_or(&t0);
+            let earliest = (ready + 1).saturating_sub(hops.len() + EAGER_WINDOW).max(1);
+            for e in (earliest..t0).rev() {
+                if arrival == soonest {
+                    break;
+                }
+                if let Some((c, s)) = self.follow(e, src, &hops, ready) {
+                    let a = *s.last().unwrap_or(&e);
+                    if a < arrival {
+                        (arrival, t0, cells, steps) = (a, e, c, s);
+                    }
+                }
+            }
+        }
         self.timing.1 += t_follow.elapsed().as_secs_f64();
         let arrival = *steps.last().unwrap_or(&t0);
         while self.positions.len() <= arrival {
