@@ -380,6 +380,25 @@ fn default_b() -> u32 {
     6
 }
 
+/// A named choice among `known`: its default when the scenario leaves it
+/// out, an error naming the scenario and the parameter when unknown.
+fn choice<T: Default>(
+    scenario: &Scenario,
+    param: &str,
+    value: Option<&str>,
+    parse: fn(&str) -> Option<T>,
+    known: &str,
+) -> Result<T, InputError> {
+    match value {
+        None => Ok(T::default()),
+        Some(name) => parse(name).ok_or_else(|| {
+            scenario.error(format!(
+                "unknown {param} '{name}' in parameter {param} (known: {known})"
+            ))
+        }),
+    }
+}
+
 /// The `scaffold` generator (seed 000).
 pub struct ScaffoldAssembly;
 
@@ -418,22 +437,20 @@ impl Generator for ScaffoldAssembly {
                 )));
             }
         };
-        let protocol = match p.protocol.as_deref() {
-            None => Protocol::Safe,
-            Some(name) => Protocol::parse(name).ok_or_else(|| {
-                scenario.error(format!(
-                    "unknown protocol '{name}' in parameter protocol (known: safe, paper)"
-                ))
-            })?,
-        };
-        let feed = match p.feed.as_deref() {
-            None => Feed::JustInTime,
-            Some(name) => Feed::parse(name).ok_or_else(|| {
-                scenario.error(format!(
-                    "unknown feed '{name}' in parameter feed (known: just-in-time, eager)"
-                ))
-            })?,
-        };
+        let protocol = choice(
+            scenario,
+            "protocol",
+            p.protocol.as_deref(),
+            Protocol::parse,
+            "safe, paper",
+        )?;
+        let feed = choice(
+            scenario,
+            "feed",
+            p.feed.as_deref(),
+            Feed::parse,
+            "just-in-time, eager",
+        )?;
         scaffold_schedule_fed(&spec, p.b, protocol, feed).map_err(|e| e.in_file(&scenario.path))
     }
 }
