@@ -167,6 +167,10 @@ pub fn planner_schedule(p: &planner::Plan, spacing_mm: f64) -> Schedule {
     s.meta
         .insert("iterations".into(), p.iterations.len().into());
     s.meta.insert(
+        "source_width".into(),
+        p.source_width.map_or("every leaf".into(), |w| w.into()),
+    );
+    s.meta.insert(
         "iteration_detail".into(),
         serde_json::to_value(&p.iterations).expect("iterations serialise"),
     );

@@ -187,6 +187,72 @@ pub fn move_catoms(
         paths: Vec::new(),
         best_depth: (0, 0),
     };
+    if std::env::var("RC_DBG").is_ok() && !strict {
+        use crate::lattice::{FccLattice, Lattice};
+        use std::io::Write;
+        let l = FccLattice;
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .create(true)
+            .open("/tmp/dbg.txt")
+            .unwrap();
+        let src = sources[0];
+        let mut me = s.clone();
+        me.at.remove(&src);
+        let mut seen: FxHashSet<Cell> = FxHashSet::from_iter([src]);
+        let mut q = std::collections::VecDeque::from([src]);
+        while let Some(c) = q.pop_front() {
+            for h in me.hops(c, false) {
+                if seen.insert(h.to) {
+                    q.push_back(h.to);
+                }
+            }
+        }
+        let t = targets
+            .iter()
+            .copied()
+            .find(|t| (0..12).any(|k| s.at.contains_key(&l.neighbour(*t, k))));
+        let _ = writeln!(
+            f,
+            "box {:?}..{:?} region {} reachable {} from {src:?}",
+            s.lo,
+            s.hi,
+            s.region.is_some(),
+            seen.len()
+        );
+        if let Some(t) = t {
+            let piv: Vec<Cell> = (0..12)
+                .map(|k| l.neighbour(t, k))
+                .filter(|q| s.at.contains_key(q))
+                .collect();
+            let _ = writeln!(f, "  target {t:?} pivots {piv:?}");
+            for p in &piv {
+                for k in 0..12 {
+                    let c = l.neighbour(*p, k);
+                    if s.at.contains_key(&c) || c == t {
+                        continue;
+                    }
+                    let adj_t = (0..12).any(|j| l.neighbour(t, j) == c);
+                    let hops_to_t = {
+                        let mut m2 = me.clone();
+                        m2.at.remove(&c);
+                        m2.hops(c, false).iter().any(|h| h.to == t)
+                    };
+                    let best = seen
+                        .iter()
+                        .map(|r| (r.x - c.x).abs() + (r.y - c.y).abs() + (r.z - c.z).abs())
+                        .min()
+                        .unwrap_or(-1);
+                    let _ = writeln!(
+                        f,
+                        "   around pivot {p:?}: free {c:?} adj_target {adj_t} reachable {} hop_to_target {hops_to_t} in_box {} nearest_reach {best}",
+                        seen.contains(&c),
+                        me.in_box(c)
+                    );
+                }
+            }
+        }
+    }
     if search.run(s, 0, 0) {
         Ok(search.paths)
     } else {

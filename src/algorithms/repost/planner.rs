@@ -6,7 +6,8 @@
 //! 1. **Sources**: SPARSE meta-modules outside the goal that are leaves of
 //!    a breadth-first spanning tree rooted at the global coordinator (a
 //!    meta-module in both shapes, the lowest), so that dismantling all of
-//!    them together leaves the rest connected.
+//!    them together leaves the rest connected; when that plan fails, only
+//!    the leaves nearest the far end of the structure (see [`plan`]).
 //! 2. **Destinations**: SPARSE goal meta-modules next to an empty goal
 //!    cell; each empty goal cell goes to exactly one destination and each
 //!    destination serves one cell.
@@ -91,6 +92,9 @@ pub struct Plan {
     /// Streamlines in use at each step (for Fig. 9).
     pub streamlines_at: Vec<usize>,
     pub ground: i32,
+    /// The source rule that planned: `None` every leaf, `Some(w)` leaves
+    /// within `w` BFS levels of the deepest (see [`plan`]).
+    pub source_width: Option<usize>,
 }
 
 /// The cells of a meta-module's box: where its catoms and the catoms
@@ -102,6 +106,27 @@ fn region(m: Meta) -> impl Iterator<Item = Cell> {
     })
 }
 
+/// The breadth-first spanning tree of `present` from `root`: each
+/// meta-module's level, and how many children each has (leaves have none).
+fn spanning_tree(
+    present: &FxHashSet<Meta>,
+    root: Meta,
+) -> (FxHashMap<Meta, usize>, FxHashMap<Meta, usize>) {
+    let mut depth = FxHashMap::from_iter([(root, 0)]);
+    let mut children: FxHashMap<Meta, usize> = FxHashMap::default();
+    let mut queue = VecDeque::from([root]);
+    while let Some(m) = queue.pop_front() {
+        for n in adjacent(m) {
+            if present.contains(&n) && !depth.contains_key(&n) {
+                depth.insert(n, depth[&m] + 1);
+                *children.entry(m).or_default() += 1;
+                queue.push_back(n);
+            }
+        }
+    }
+    (depth, children)
+}
+
 fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
     super::metamodule::Direction::ALL
         .into_iter()
@@ -109,10 +134,48 @@ fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
 }
 
 /// Plans the reconfiguration from `initial` to `goal` (meta-module states).
+///
+/// Which leaves to dismantle first is the paper's free choice. Taking
+/// every leaf can wall a source in: a SPARSE meta-module on the ground
+/// between two others whose loops leave its catoms no rotation path out
+/// (L→C: source (4, 0, −1) beside (5, 0, −1), its catoms reaching only 42
+/// cells). So the plan is tried with every leaf as a source, then peeling
+/// from the far end — only leaves within `w` BFS levels of the deepest,
+/// `w` from the structure's depth down to 0 — and the first width that
+/// plans is kept (`Plan::source_width`).
 pub fn plan(
     initial: &BTreeMap<Meta, State>,
     goal: &BTreeSet<Meta>,
     rules: &dyn MotionRules,
+) -> Result<Plan, PlanError> {
+    let first = match plan_with(initial, goal, rules, None) {
+        Ok(p) => return Ok(p),
+        Err(e @ (PlanError::Bound { .. } | PlanError::NoCoordinator)) => return Err(e),
+        Err(e) => e,
+    };
+    let deepest = initial
+        .keys()
+        .filter(|m| goal.contains(m))
+        .min_by_key(|m| (m.z, m.x, m.y))
+        .map_or(0, |&gc| {
+            let state: FxHashSet<Meta> = initial.keys().copied().collect();
+            spanning_tree(&state, gc).0.into_values().max().unwrap_or(0)
+        });
+    for w in (0..deepest).rev() {
+        if let Ok(p) = plan_with(initial, goal, rules, Some(w)) {
+            return Ok(p);
+        }
+    }
+    Err(first)
+}
+
+/// [`plan`] with sources restricted to leaves within `width` BFS levels of
+/// the deepest leaf (`None`: every leaf).
+fn plan_with(
+    initial: &BTreeMap<Meta, State>,
+    goal: &BTreeSet<Meta>,
+    rules: &dyn MotionRules,
+    width: Option<usize>,
 ) -> Result<Plan, PlanError> {
     let catoms: usize = initial
         .values()
@@ -142,6 +205,7 @@ pub fn plan(
     let mut out = Plan {
         modules,
         ground,
+        source_width: width,
         ..Default::default()
     };
     loop {
@@ -159,22 +223,17 @@ pub fn plan(
             return Ok(out);
         }
         // 1. Sources: leaves of the BFS tree from the coordinator.
-        let mut children: FxHashMap<Meta, usize> = FxHashMap::default();
-        let mut seen = FxHashSet::from_iter([gc]);
-        let mut queue = VecDeque::from([gc]);
-        while let Some(m) = queue.pop_front() {
-            for n in adjacent(m) {
-                if state.contains_key(&n) && seen.insert(n) {
-                    *children.entry(m).or_default() += 1;
-                    queue.push_back(n);
-                }
-            }
-        }
-        let sources: Vec<Meta> = extra
+        let present: FxHashSet<Meta> = state.keys().copied().collect();
+        let (depth, children) = spanning_tree(&present, gc);
+        let mut sources: Vec<Meta> = extra
             .iter()
             .filter(|m| children.get(m).copied().unwrap_or(0) == 0 && state[m] == State::Sparse)
             .copied()
             .collect();
+        if let Some(w) = width {
+            let deepest = sources.iter().map(|m| depth[m]).max().unwrap_or(0);
+            sources.retain(|m| depth[m] + w >= deepest);
+        }
         // 2. Destinations: one per empty goal cell, lowest cells first.
         // Built bottom-up: a goal cell whose cell below is empty waits
         // (a meta-module would otherwise hang from its destination).
@@ -258,6 +317,24 @@ pub fn plan(
                         progress = true;
                     }
                     Err(c) => {
+                        if std::env::var("RC_DBG").is_ok() {
+                            use std::io::Write;
+                            let mut f = std::fs::OpenOptions::new()
+                                .append(true)
+                                .create(true)
+                                .open("/tmp/dbg.txt")
+                                .unwrap();
+                            let adj: Vec<Meta> =
+                                adjacent(src).filter(|n| state.contains_key(n)).collect();
+                            let _ = writeln!(
+                                f,
+                                "FAIL line {:?} goal {:?} src adjacent present {:?} state size {}",
+                                line,
+                                goal_meta,
+                                adj,
+                                state.len()
+                            );
+                        }
                         stuck.get_or_insert((goal_meta, c));
                         deferred.insert(src);
                     }
