@@ -106,6 +106,15 @@ fn region(m: Meta) -> impl Iterator<Item = Cell> {
     })
 }
 
+/// The global coordinator: the lowest meta-module in both shapes.
+fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeSet<Meta>) -> Option<Meta> {
+    initial
+        .keys()
+        .filter(|m| goal.contains(m))
+        .min_by_key(|m| (m.z, m.x, m.y))
+        .copied()
+}
+
 /// The breadth-first spanning tree of `present` from `root`: each
 /// meta-module's level, and how many children each has (leaves have none).
 fn spanning_tree(
@@ -153,14 +162,10 @@ pub fn plan(
         Err(e @ (PlanError::Bound { .. } | PlanError::NoCoordinator)) => return Err(e),
         Err(e) => e,
     };
-    let deepest = initial
-        .keys()
-        .filter(|m| goal.contains(m))
-        .min_by_key(|m| (m.z, m.x, m.y))
-        .map_or(0, |&gc| {
-            let state: FxHashSet<Meta> = initial.keys().copied().collect();
-            spanning_tree(&state, gc).0.into_values().max().unwrap_or(0)
-        });
+    let deepest = coordinator(initial, goal).map_or(0, |gc| {
+        let state: FxHashSet<Meta> = initial.keys().copied().collect();
+        spanning_tree(&state, gc).0.into_values().max().unwrap_or(0)
+    });
     for w in (0..deepest).rev() {
         if let Ok(p) = plan_with(initial, goal, rules, Some(w)) {
             return Ok(p);
@@ -187,11 +192,7 @@ fn plan_with(
             goal: goal.len(),
         });
     }
-    let gc = *initial
-        .keys()
-        .filter(|m| goal.contains(m))
-        .min_by_key(|m| (m.z, m.x, m.y))
-        .ok_or(PlanError::NoCoordinator)?;
+    let gc = coordinator(initial, goal).ok_or(PlanError::NoCoordinator)?;
     let ground = 4 * initial.keys().map(|m| m.z).min().unwrap_or(0);
     let mut scene = Scene::new(Some(ground));
     let mut modules = Vec::new();
