@@ -48,15 +48,14 @@ impl Metric {
     }
 }
 
-/// The title's note of the feed, when it is not the default for every run.
+/// The title's note of the feeds, when a run does not use the default.
 fn feeds(runs: &[Run]) -> String {
     use crate::algorithms::scaffold::feed::Feed;
-    let mut names: Vec<&str> = runs.iter().map(|r| r.feed.name()).collect();
-    names.dedup();
-    if runs.iter().all(|r| r.feed == Feed::JustInTime) {
+    let names: std::collections::BTreeSet<&str> = runs.iter().map(|r| r.feed.name()).collect();
+    if runs.iter().all(|r| r.feed == Feed::default()) {
         String::new()
     } else {
-        format!(", feed {}", names.join(" / "))
+        format!(", feed {}", Vec::from_iter(names).join(" / "))
     }
 }
 

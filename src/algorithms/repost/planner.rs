@@ -115,10 +115,11 @@ fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeSet<Meta>) -> Option
         .copied()
 }
 
-/// The breadth-first spanning tree of `present` from `root`: each
-/// meta-module's level, and how many children each has (leaves have none).
+/// The breadth-first spanning tree of the meta-modules `present` from
+/// `root`: each reached one's level, and how many children each has
+/// (leaves have none).
 fn spanning_tree(
-    present: &FxHashSet<Meta>,
+    present: impl Fn(&Meta) -> bool,
     root: Meta,
 ) -> (FxHashMap<Meta, usize>, FxHashMap<Meta, usize>) {
     let mut depth = FxHashMap::from_iter([(root, 0)]);
@@ -126,7 +127,7 @@ fn spanning_tree(
     let mut queue = VecDeque::from([root]);
     while let Some(m) = queue.pop_front() {
         for n in adjacent(m) {
-            if present.contains(&n) && !depth.contains_key(&n) {
+            if present(&n) && !depth.contains_key(&n) {
                 depth.insert(n, depth[&m] + 1);
                 *children.entry(m).or_default() += 1;
                 queue.push_back(n);
@@ -163,8 +164,8 @@ pub fn plan(
         Err(e) => e,
     };
     let deepest = coordinator(initial, goal).map_or(0, |gc| {
-        let state: FxHashSet<Meta> = initial.keys().copied().collect();
-        spanning_tree(&state, gc).0.into_values().max().unwrap_or(0)
+        let (depth, _) = spanning_tree(|m| initial.contains_key(m), gc);
+        depth.into_values().max().unwrap_or(0)
     });
     for w in (0..deepest).rev() {
         if let Ok(p) = plan_with(initial, goal, rules, Some(w)) {
@@ -224,16 +225,18 @@ fn plan_with(
             return Ok(out);
         }
         // 1. Sources: leaves of the BFS tree from the coordinator.
-        let present: FxHashSet<Meta> = state.keys().copied().collect();
-        let (depth, children) = spanning_tree(&present, gc);
+        let (depth, children) = spanning_tree(|m| state.contains_key(m), gc);
         let mut sources: Vec<Meta> = extra
             .iter()
             .filter(|m| children.get(m).copied().unwrap_or(0) == 0 && state[m] == State::Sparse)
             .copied()
             .collect();
         if let Some(w) = width {
-            let deepest = sources.iter().map(|m| depth[m]).max().unwrap_or(0);
-            sources.retain(|m| depth[m] + w >= deepest);
+            // A source the tree does not reach (a disconnected input) has
+            // no level; it counts as the coordinator's.
+            let level = |m: &Meta| depth.get(m).copied().unwrap_or(0);
+            let deepest = sources.iter().map(level).max().unwrap_or(0);
+            sources.retain(|m| level(m) + w >= deepest);
         }
         // 2. Destinations: one per empty goal cell, lowest cells first.
         // Built bottom-up: a goal cell whose cell below is empty waits
@@ -318,24 +321,6 @@ fn plan_with(
                         progress = true;
                     }
                     Err(c) => {
-                        if std::env::var("RC_DBG").is_ok() {
-                            use std::io::Write;
-                            let mut f = std::fs::OpenOptions::new()
-                                .append(true)
-                                .create(true)
-                                .open("/tmp/dbg.txt")
-                                .unwrap();
-                            let adj: Vec<Meta> =
-                                adjacent(src).filter(|n| state.contains_key(n)).collect();
-                            let _ = writeln!(
-                                f,
-                                "FAIL line {:?} goal {:?} src adjacent present {:?} state size {}",
-                                line,
-                                goal_meta,
-                                adj,
-                                state.len()
-                            );
-                        }
                         stuck.get_or_insert((goal_meta, c));
                         deferred.insert(src);
                     }

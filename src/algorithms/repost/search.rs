@@ -109,7 +109,7 @@ impl Scene {
         self.hi = Cell::new(hi.x + margin, hi.y + margin, hi.z + margin);
     }
 
-    pub fn in_box(&self, c: Cell) -> bool {
+    fn in_box(&self, c: Cell) -> bool {
         if let Some(r) = &self.region {
             return r.contains(&c);
         }
