@@ -56,6 +56,9 @@ enum Command {
     /// Seed 003 §V-B1: active subtraction on random configurations of
     /// several densities; prints a table and draws a box plot.
     DensityStudy(cli::density::Args),
+    /// Seed 001: concurrent rotations and streamlines per time step
+    /// (Fig. 9) of a RePoSt scenario, with a table per iteration.
+    RepostStudy(cli::repost::Args),
     /// Seed 002: messages against modules (Fig. 10), available docking
     /// positions against percent built (Fig. 11) and the naive orders of
     /// Fig. 3, as tables.
@@ -109,6 +112,7 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
         Command::Loadmap(a) => cli::pictures::loadmap(a),
         Command::DensityStudy(a) => cli::density::run(a),
         Command::DockingStudy(a) => cli::docking::run(a),
+        Command::RepostStudy(a) => cli::repost::run(a),
         Command::CombStudy(a) => cli::comb::run(a),
         Command::Rules { json } => {
             let t = reconfcheck::geometry::table();

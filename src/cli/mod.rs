@@ -16,4 +16,5 @@ pub mod parallel;
 pub mod pictures;
 pub mod progress;
 pub mod report;
+pub mod repost;
 pub mod schedule;

@@ -16,6 +16,7 @@ pub mod density;
 pub mod docking_figures;
 mod loadmap;
 mod placed;
+pub mod repost_figures;
 pub mod scaffold_figures;
 
 pub use b_study::plot as b_study_plot;

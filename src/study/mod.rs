@@ -7,5 +7,6 @@ pub mod comb;
 pub mod density;
 pub mod docking;
 pub mod fit;
+pub mod repost;
 pub mod scaffold_figures;
 pub mod synthetic;

@@ -224,9 +224,167 @@ fn the_l_to_c_planner_completes_and_its_schedule_is_collision_free() {
     want.sort();
     got.sort();
     assert_eq!(got, want);
+    // The streamlines run pipelined: every iteration, and several catoms
+    // per step (one at a time would be 7,186 steps).
+    let detail = s.meta["iteration_detail"].as_array().unwrap();
+    assert!(
+        detail.iter().all(|it| it["pipelined"] == true),
+        "{detail:?}"
+    );
+    let rotations: usize = s.steps.iter().map(|st| st.events.len()).sum();
+    assert!(
+        rotations >= 4 * s.steps.len(),
+        "{rotations} rotations in {} steps",
+        s.steps.len()
+    );
+    assert!(s.steps.iter().any(|st| st.events.len() >= 10));
+    // Concurrent movers are exactly what the certifier checks pairwise
+    // with the exact body.
     let mut geometry_only = s.clone();
     geometry_only.model = None;
     let r = certify(&geometry_only, &Options::default()).unwrap();
     assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
     assert!(r.certified, "{}", r.summary());
+}
+
+/// Two catoms rolling along a row on the ground, the second planned
+/// against the first's end state: pipelined, the second follows the first
+/// instead of waiting for it to arrive, and the certifier (lattice, exact
+/// sweeps of both movers) finds nothing; the sequential order is the
+/// sum of the paths.
+#[test]
+fn a_follower_catom_sets_off_before_its_leader_arrives_and_the_pipeline_certifies() {
+    use reconfcheck::algorithms::repost::pipeline::pipeline;
+    use reconfcheck::algorithms::repost::search::Scene;
+    use reconfcheck::lattice::LatticeKind;
+    use reconfcheck::schedule::{Event, ModuleSpec, Schedule, Step};
+    let mut scene = Scene::new(Some(0));
+    let mut cells: Vec<Cell> = (0..10).map(|x| Cell::new(x, 0, 0)).collect();
+    cells.extend([Cell::new(1, 0, 1), Cell::new(0, 0, 1)]);
+    for (id, c) in cells.iter().enumerate() {
+        scene.insert(id as u32, *c);
+    }
+    scene.fit_box(&[], 2);
+    let (lead, follow) = (Cell::new(1, 0, 1), Cell::new(0, 0, 1));
+    let (lead_goal, follow_goal) = (Cell::new(8, 0, 1), Cell::new(7, 0, 1));
+    let p1 = scene
+        .route(lead, lead_goal, false)
+        .expect("the leader has a path");
+    let mut after = scene.clone();
+    let id = after.at.remove(&lead).unwrap();
+    after.insert(id, lead_goal);
+    let p2 = after
+        .route(follow, follow_goal, false)
+        .expect("the follower has a path");
+    let rules = reconfcheck::geometry::motion_rules(LatticeKind::Fcc).unwrap();
+    let out = pipeline(&scene, &[vec![p1.clone(), p2.clone()]], rules)
+        .expect("the pipeline keeps the row anchored");
+    let rotations: usize = out.steps.iter().map(Vec::len).sum();
+    assert_eq!(rotations, p1.len() + p2.len());
+    assert!(
+        out.steps.len() < p1.len() + p2.len(),
+        "{} steps, sequential {}",
+        out.steps.len(),
+        p1.len() + p2.len()
+    );
+    assert!(out.steps.iter().any(|s| s.len() == 2));
+    assert!(out.lanes_at.iter().all(|&n| n == 1));
+    // Replay as a schedule and certify it.
+    let mut s = Schedule::new(LatticeKind::Fcc, reconfcheck::schedule::Length::mm(3.6));
+    s.ground = Some(reconfcheck::lattice::Ground { layer: 0 });
+    for (id, c) in cells.iter().enumerate() {
+        s.modules.push(ModuleSpec {
+            id: id as u32,
+            cell: *c,
+            fixed: false,
+        });
+    }
+    let mut at = scene.at.clone();
+    for step in &out.steps {
+        let events: Vec<Event> = step
+            .iter()
+            .map(|h| Event::Rotate {
+                module: at[&h.from],
+                pivot: at[&h.pivot],
+                from: h.from,
+                to: h.to,
+                route: h.route,
+            })
+            .collect();
+        for h in step {
+            let m = at.remove(&h.from).unwrap();
+            at.insert(h.to, m);
+        }
+        s.steps.push(Step { events });
+    }
+    assert_eq!(at.get(&lead_goal), Some(&10));
+    assert_eq!(at.get(&follow_goal), Some(&11));
+    let r = certify(&s, &Options::default()).unwrap();
+    assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
+    assert!(r.certified, "{}", r.summary());
+}
+
+/// `repost-study` on a three-meta-module line whose end climbs onto the
+/// middle: the iteration table (with the paper's peak, 10 × streamlines),
+/// Fig. 9 drawn as a PNG, and the JSON curves, whose rotations add up to
+/// the table's; a scenario of another generator is refused with exit 2,
+/// naming the file.
+#[test]
+fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
+    let tag = "repost-study";
+    std::fs::write(common::scratch(tag, "i.txt"), "0 0 0\n4 0 0\n8 0 0\n").unwrap();
+    std::fs::write(common::scratch(tag, "g.txt"), "0 0 0\n4 0 0\n4 -1 4\n").unwrap();
+    let sc = common::scratch(tag, "s.toml");
+    std::fs::write(
+        &sc,
+        "name = \"climb\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"i.txt\"\ngoal = \"g.txt\"\n",
+    )
+    .unwrap();
+    let (png, json) = (
+        common::scratch(tag, "f9.png"),
+        common::scratch(tag, "f9.json"),
+    );
+    let o = common::bin()
+        .arg("repost-study")
+        .arg(&sc)
+        .arg("--plot")
+        .arg(&png)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.contains("Fig. 9, climb"), "{out}");
+    assert!(out.contains("10×streaml."), "{out}");
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let motions: u64 = v["motions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_u64().unwrap())
+        .sum();
+    let rows = v["iterations"].as_array().unwrap();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0]["rotations"].as_u64(), Some(motions));
+    assert!(motions >= 10, "{motions} rotations to build a loop of ten");
+    assert!(out.contains(&format!("{motions} rotations")), "{out}");
+    // Another generator's scenario.
+    let o = common::bin()
+        .args(["repost-study", "scenarios/repost-operation.toml"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("repost-operation.toml") && err.contains("algorithm"),
+        "{err}"
+    );
 }

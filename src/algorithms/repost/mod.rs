@@ -15,6 +15,7 @@
 
 pub mod metamodule;
 pub mod operations;
+pub mod pipeline;
 pub mod planner;
 pub mod search;
 pub mod shape;
@@ -194,21 +195,28 @@ impl Generator for Repost {
     }
 
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
-        let p: PlannerParams = parameters(scenario)?;
-        let (ip, gp) = (scenario.resolve(&p.initial), scenario.resolve(&p.goal));
-        let initial = shape::load(&ip)?;
-        let goal: std::collections::BTreeSet<_> = shape::load(&gp)?.into_keys().collect();
-        let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
-            .expect("the FCC lattice has derived motion rules");
-        let plan = planner::plan(&initial, &goal, rules).map_err(|e| {
-            let file = match e {
-                planner::PlanError::Bound { .. }
-                | planner::PlanError::Unreachable(_)
-                | planner::PlanError::Stuck(..) => &gp,
-                planner::PlanError::NoCoordinator => &ip,
-            };
-            InputError::new(e.to_string()).in_file(file)
-        })?;
-        Ok(planner_schedule(&plan, p.spacing_mm))
+        let (plan, spacing_mm) = plan_scenario(scenario)?;
+        Ok(planner_schedule(&plan, spacing_mm))
     }
+}
+
+/// The plan of a `repost` scenario and its lattice spacing (mm); a goal
+/// the planner cannot reach is refused naming the goal file.
+pub fn plan_scenario(scenario: &Scenario) -> Result<(planner::Plan, f64), InputError> {
+    let p: PlannerParams = parameters(scenario)?;
+    let (ip, gp) = (scenario.resolve(&p.initial), scenario.resolve(&p.goal));
+    let initial = shape::load(&ip)?;
+    let goal: std::collections::BTreeSet<_> = shape::load(&gp)?.into_keys().collect();
+    let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
+        .expect("the FCC lattice has derived motion rules");
+    let plan = planner::plan(&initial, &goal, rules).map_err(|e| {
+        let file = match e {
+            planner::PlanError::Bound { .. }
+            | planner::PlanError::Unreachable(_)
+            | planner::PlanError::Stuck(..) => &gp,
+            planner::PlanError::NoCoordinator => &ip,
+        };
+        InputError::new(e.to_string()).in_file(file)
+    })?;
+    Ok((plan, p.spacing_mm))
 }

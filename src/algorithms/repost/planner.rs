@@ -16,20 +16,21 @@
 //!    algorithm (`petgraph::algo::dinics`): streamlines are
 //!    vertex-disjoint, as in the authors' code, because two streamlines
 //!    crossing one meta-module would cross inside its loop.
-//! 4. **Transport**: each streamline's ten catoms travel inside the
-//!    streamline's meta-modules (their cell boxes) to the goal cell, one
-//!    catom at a time per streamline ([`super::operations::move_catoms`]),
-//!    the streamlines side by side: the k-th rotation of every streamline
-//!    runs in one time step when the motion rules say the rotations are
-//!    clear of each other and of the other streamlines' catoms, and is
-//!    delayed otherwise.
+//! 4. **Transport**: each streamline's ten catoms get their paths inside
+//!    the streamline's meta-modules (their cell boxes) to the goal cell,
+//!    each planned against the end state of the ones before it
+//!    ([`super::operations::move_catoms`]); then they run pipelined, one
+//!    behind another, the streamlines side by side
+//!    ([`super::pipeline`]), or one at a time if the pipeline fails its
+//!    anchoring replay.
 
 use super::metamodule::{Meta, State};
 use super::operations::move_catoms;
+use super::pipeline::pipeline;
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
+use crate::lattice::Cell;
 use crate::lattice::config::ModuleId;
-use crate::lattice::{Cell, Motion};
 use petgraph::graph::{DiGraph, NodeIndex};
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
@@ -80,6 +81,9 @@ pub struct Iteration {
     pub first_step: usize,
     pub steps: usize,
     pub motions: usize,
+    /// Whether the streamlines ran pipelined ([`super::pipeline`]) or,
+    /// the pipeline failing its anchoring replay, one catom at a time.
+    pub pipelined: bool,
 }
 
 /// The plan: the initial catoms and the steps of rotations.
@@ -270,8 +274,7 @@ fn plan_with(
         // a neighbour that a later iteration dismantles first).
         let first_step = out.steps.len();
         let before = scene.clone();
-        let mut lanes: Vec<Vec<(Cell, Hop)>> = Vec::new();
-        let mut goals: Vec<Meta> = Vec::new();
+        let mut lanes: Vec<Vec<Vec<Hop>>> = Vec::new();
         let mut planned: Vec<Vec<Meta>> = Vec::new();
         let mut deferred: FxHashSet<Meta> = FxHashSet::default();
         let mut stuck = None;
@@ -306,15 +309,7 @@ fn plan_with(
                             let id = scene.at.remove(&a).expect("mover in place");
                             scene.insert(id, b);
                         }
-                        let mut lane = Vec::new();
-                        for p in paths {
-                            let start = p[0].from;
-                            for h in p {
-                                lane.push((start, h));
-                            }
-                        }
-                        lanes.push(lane);
-                        goals.push(goal_meta);
+                        lanes.push(paths);
                         state.remove(&src);
                         state.insert(goal_meta, State::Sparse);
                         planned.push(line);
@@ -343,18 +338,20 @@ fn plan_with(
             });
         }
         let streamlines = planned;
-        let motions: usize = lanes.iter().map(Vec::len).sum();
+        let motions: usize = lanes.iter().flatten().map(Vec::len).sum();
         scene = before.clone();
-        if merge_lanes(&mut scene, lanes.clone(), rules, &mut out).is_err() {
-            // The side-by-side run deadlocked: run the streamlines one
-            // after another, the order they were planned in (valid by
-            // construction).
-            scene = before;
-            out.steps.truncate(first_step);
-            out.streamlines_at.truncate(first_step);
+        let pipelined = pipeline(&before, &lanes, rules);
+        let is_pipelined = pipelined.is_some();
+        if let Some(p) = pipelined {
+            emit(&mut scene, p.steps, p.lanes_at, &mut out);
+        } else {
+            // The pipeline left the structure unanchored at some step: run
+            // the streamlines one after another, the order they were
+            // planned in (valid by construction).
             for lane in lanes {
-                merge_lanes(&mut scene, vec![lane], rules, &mut out)
-                    .map_err(|(_, c)| PlanError::Stuck(goals[0], c))?;
+                let steps: Vec<Vec<Hop>> = lane.into_iter().flatten().map(|h| vec![h]).collect();
+                let n = steps.len();
+                emit(&mut scene, steps, vec![1; n], &mut out);
             }
         }
         out.iterations.push(Iteration {
@@ -369,6 +366,7 @@ fn plan_with(
             steps: out.steps.len() - first_step,
             first_step,
             motions,
+            pipelined: is_pipelined,
             streamlines: streamlines.clone(),
         });
     }
@@ -481,75 +479,20 @@ fn streamlines(
     lines
 }
 
-/// Runs the lanes side by side: each step takes the next rotation of every
-/// lane whose rotation is clear of the step's other rotations and of the
-/// other lanes' catoms (rules), and whose pivot is not moving.
-fn merge_lanes(
-    scene: &mut Scene,
-    lanes: Vec<Vec<(Cell, Hop)>>,
-    rules: &dyn MotionRules,
-    out: &mut Plan,
-) -> Result<(), (usize, Cell)> {
-    let mut pos: Vec<usize> = vec![0; lanes.len()];
-    // Where each lane's current mover is, by its start cell.
-    let mut cur: Vec<Option<Cell>> = vec![None; lanes.len()];
-    loop {
-        let live: Vec<usize> = (0..lanes.len())
-            .filter(|&i| pos[i] < lanes[i].len())
-            .collect();
-        if live.is_empty() {
-            break;
-        }
-        let mut step: Vec<(usize, Hop)> = Vec::new();
-        for &i in &live {
-            let (_, h) = lanes[i][pos[i]];
-            let m = Motion::Rotate {
-                from: h.from,
-                to: h.to,
-                pivot: h.pivot,
-                route: h.route,
-            };
-            // Cells below the ground are not modules: the ground plane is
-            // checked by the search itself.
-            let occupied = |c: Cell| scene.at.contains_key(&c) && c != h.from;
-            let ok = scene.at.contains_key(&h.pivot)
-                && !scene.blocked(h.to)
-                && rules.allows(&m, &occupied)
-                && step.iter().all(|(_, o)| {
-                    let om = Motion::Rotate {
-                        from: o.from,
-                        to: o.to,
-                        pivot: o.pivot,
-                        route: o.route,
-                    };
-                    o.to != h.to
-                        && o.from != h.pivot
-                        && h.from != o.pivot
-                        && rules.concurrent_clear(&m, &om)
-                });
-            if ok {
-                step.push((i, h));
-            }
-        }
-        if step.is_empty() {
-            // Every lane waits on another lane's catom: a deadlock.
-            let i = live[0];
-            return Err((i, lanes[i][pos[i]].1.to));
-        }
+/// Appends `steps` of rotations to the plan, naming each mover and pivot
+/// by the module in its cell.
+fn emit(scene: &mut Scene, steps: Vec<Vec<Hop>>, lanes_at: Vec<usize>, out: &mut Plan) {
+    for (step, lanes) in steps.into_iter().zip(lanes_at) {
         let mut events = Vec::new();
-        for (i, h) in &step {
+        for h in step {
             let id = scene.at.remove(&h.from).expect("the mover is in place");
             let pivot = scene.at[&h.pivot];
-            events.push((id, pivot, *h));
-            cur[*i] = Some(h.to);
-            pos[*i] += 1;
+            events.push((id, pivot, h));
         }
         for (id, _, h) in &events {
             scene.insert(*id, h.to);
         }
-        out.streamlines_at.push(live.len());
+        out.streamlines_at.push(lanes);
         out.steps.push(events);
     }
-    let _ = cur;
-    Ok(())
 }

@@ -1,0 +1,236 @@
+//! Pipelined transport (§V, "modules of a stream keep one line"): the
+//! catoms of a streamline set off one after another and travel together,
+//! and the streamlines of an iteration run side by side.
+//!
+//! The paths come from the sequential planner (each catom planned against
+//! the end state of the ones before it), so running them one after another
+//! is valid by construction. Pipelining is prioritised planning on a time
+//! axis: the catoms are committed in that same order, each at the earliest
+//! departure step at which its whole path, rotation after rotation with no
+//! wait, is valid against everything committed before it, and everything
+//! committed before it stays valid:
+//!
+//! * every rotation: its target free and its pivot static at that step,
+//!   clear of the cells occupied at the start of the step (the motion
+//!   rules), and pairwise clear of the step's other rotations;
+//! * the catom as an obstacle: its cell at the start of every step of its
+//!   path, and its goal cell from its arrival on, must not block a
+//!   committed rotation of that step;
+//! * its start cell, once left, is not a committed rotation's pivot later,
+//!   and the structure, its movers lifted, stays anchored to the ground
+//!   when it leaves.
+//!
+//! Departing at the end of everything committed is the sequential order,
+//! so the search always ends. The finished pipeline is replayed once with
+//! the certifier's anchoring rule at every step (the structure with the
+//! step's movers lifted reaches the ground); if any step fails, the caller
+//! falls back to the sequential order.
+
+use super::search::{Hop, Scene};
+use crate::geometry::MotionRules;
+use crate::lattice::{Cell, FccLattice, Lattice, Motion};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+fn motion(h: &Hop) -> Motion {
+    Motion::Rotate {
+        from: h.from,
+        to: h.to,
+        pivot: h.pivot,
+        route: h.route,
+    }
+}
+
+/// What has been committed, on the time axis (step `t` = the `t`-th step
+/// of the iteration; positions are at the start of a step).
+struct Timeline<'a> {
+    /// Every catom at its start cell.
+    base: &'a Scene,
+    rules: &'a dyn MotionRules,
+    /// Start cell of a committed catom → the step it leaves at.
+    departed: FxHashMap<Cell, usize>,
+    /// Cells a committed catom holds after leaving its start: inclusive
+    /// step ranges (`usize::MAX`: from its arrival on).
+    visits: FxHashMap<Cell, Vec<(usize, usize)>>,
+    /// Committed rotations per step.
+    moves: Vec<Vec<Hop>>,
+    /// The last step at which a committed rotation pivots on a cell.
+    pivot_last: FxHashMap<Cell, usize>,
+}
+
+impl Timeline<'_> {
+    /// Whether `c` holds a catom at the start of step `t`, the uncommitted
+    /// catoms at their start cells. (The ground is not a module: the
+    /// planner's search keeps sweeps above it.)
+    fn occupied(&self, c: Cell, t: usize) -> bool {
+        if self.base.at.contains_key(&c) && self.departed.get(&c).is_none_or(|&d| t <= d) {
+            return true;
+        }
+        self.visits
+            .get(&c)
+            .is_some_and(|v| v.iter().any(|&(a, b)| a <= t && t <= b))
+    }
+
+    fn moves_at(&self, t: usize) -> &[Hop] {
+        self.moves.get(t).map_or(&[], Vec::as_slice)
+    }
+
+    /// Whether a catom sitting in `c` at the start of step `t` (its own
+    /// start cell `start` already left) blocks none of that step's
+    /// committed rotations.
+    fn spares(&self, c: Cell, start: Cell, t: usize) -> bool {
+        self.moves_at(t).iter().all(|o| {
+            o.to != c
+                && o.from != c
+                && self.rules.allows(&motion(o), &|x| {
+                    x != o.from && (x == c || (x != start && self.occupied(x, t)))
+                })
+        })
+    }
+
+    /// Whether the catom in `start`, leaving at step `t0` and rotating
+    /// along `path` without waiting, fits the committed timeline.
+    fn fits(&self, start: Cell, path: &[Hop], t0: usize) -> bool {
+        if self.pivot_last.get(&start).is_some_and(|&p| p >= t0) {
+            return false;
+        }
+        for (j, h) in path.iter().enumerate() {
+            let t = t0 + j;
+            let others = self.moves_at(t);
+            let occ = |c: Cell| c != h.from && c != start && self.occupied(c, t);
+            if self.occupied(h.to, t)
+                || self.base.ground.is_some_and(|g| h.to.z < g)
+                || !occ(h.pivot)
+                || others
+                    .iter()
+                    .any(|o| o.from == h.pivot || o.pivot == h.from || o.to == h.to)
+            {
+                return false;
+            }
+            let m = motion(h);
+            if !self.rules.allows(&m, &occ)
+                || !others
+                    .iter()
+                    .all(|o| self.rules.concurrent_clear(&m, &motion(o)))
+            {
+                return false;
+            }
+            if j > 0 && !self.spares(h.from, start, t) {
+                return false;
+            }
+        }
+        let goal = path.last().map_or(start, |h| h.to);
+        (t0 + path.len()..self.moves.len()).all(|t| self.spares(goal, start, t))
+            && self.anchored(t0, Some(start))
+    }
+
+    fn commit(&mut self, start: Cell, path: &[Hop], t0: usize) {
+        let Some(last) = path.last() else {
+            return;
+        };
+        self.departed.insert(start, t0);
+        for (j, h) in path.iter().enumerate() {
+            let t = t0 + j;
+            if j > 0 {
+                self.visits.entry(h.from).or_default().push((t, t));
+            }
+            if self.moves.len() <= t {
+                self.moves.resize_with(t + 1, Vec::new);
+            }
+            self.moves[t].push(*h);
+            let p = self.pivot_last.entry(h.pivot).or_default();
+            *p = (*p).max(t);
+        }
+        self.visits
+            .entry(last.to)
+            .or_default()
+            .push((t0 + path.len(), usize::MAX));
+    }
+
+    /// Whether, with the movers of step `t` lifted (and `leaving`, a catom
+    /// about to move then), every catom at rest reaches the ground
+    /// through latched neighbours: the certifier's anchoring rule.
+    fn anchored(&self, t: usize, leaving: Option<Cell>) -> bool {
+        let Some(g) = self.base.ground else {
+            return true;
+        };
+        let lifted: FxHashSet<Cell> = self
+            .moves_at(t)
+            .iter()
+            .map(|h| h.from)
+            .chain(leaving)
+            .collect();
+        let rest: FxHashSet<Cell> = self
+            .base
+            .at
+            .keys()
+            .chain(self.visits.keys())
+            .copied()
+            .filter(|c| !lifted.contains(c) && self.occupied(*c, t))
+            .collect();
+        let l = FccLattice;
+        let mut stack: Vec<Cell> = rest.iter().copied().filter(|c| c.z == g).collect();
+        let mut seen: FxHashSet<Cell> = stack.iter().copied().collect();
+        while let Some(c) = stack.pop() {
+            for n in l.neighbours(c) {
+                if rest.contains(&n) && seen.insert(n) {
+                    stack.push(n);
+                }
+            }
+        }
+        seen.len() == rest.len()
+    }
+}
+
+/// An iteration's rotations, step by step.
+pub struct Pipelined {
+    pub steps: Vec<Vec<Hop>>,
+    /// How many lanes (streamlines) are under way at each step: from
+    /// their first catom's departure to their last one's arrival.
+    pub lanes_at: Vec<usize>,
+}
+
+/// The catoms of each lane (one path per catom, in the order planned)
+/// pipelined and the lanes side by side; `None` when the pipeline does not
+/// pass the anchoring replay.
+pub fn pipeline(
+    before: &Scene,
+    lanes: &[Vec<Vec<Hop>>],
+    rules: &dyn MotionRules,
+) -> Option<Pipelined> {
+    let mut tl = Timeline {
+        base: before,
+        rules,
+        departed: FxHashMap::default(),
+        visits: FxHashMap::default(),
+        moves: Vec::new(),
+        pivot_last: FxHashMap::default(),
+    };
+    let mut spans = Vec::new();
+    for lane in lanes {
+        let mut earliest = 0;
+        let mut span: Option<(usize, usize)> = None;
+        for path in lane {
+            let Some(first) = path.first() else {
+                continue;
+            };
+            let start = first.from;
+            let horizon = tl.moves.len();
+            let t0 = (earliest..=horizon.max(earliest)).find(|&t0| tl.fits(start, path, t0))?;
+            tl.commit(start, path, t0);
+            earliest = t0 + 1;
+            let end = t0 + path.len() - 1;
+            span = Some(span.map_or((t0, end), |(a, b)| (a.min(t0), b.max(end))));
+        }
+        spans.extend(span);
+    }
+    if !(0..tl.moves.len()).all(|t| tl.anchored(t, None)) {
+        return None;
+    }
+    let lanes_at = (0..tl.moves.len())
+        .map(|t| spans.iter().filter(|(a, b)| *a <= t && t <= *b).count())
+        .collect();
+    Some(Pipelined {
+        steps: tl.moves,
+        lanes_at,
+    })
+}
