@@ -85,3 +85,91 @@ pub fn fig9(f: &Fig9, path: &Path) -> Result<(), Error> {
     })?;
     crate::render::save(&svg, path, 1.0)
 }
+
+/// Draws Fig. 10 as PNG (or SVG): rotations against meta-modules, and time
+/// steps against the diameter, each with its least-squares line.
+pub fn fig10(f: &crate::study::repost::Fig10, path: &Path) -> Result<(), Error> {
+    let svg = crate::render::svg(path, |svg| {
+        let root = SvgCanvas::with_string(svg, (900, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        let (left, right) = root.split_horizontally(450);
+        let size: Vec<(f64, f64)> = f
+            .rows
+            .iter()
+            .map(|r| (r.metas as f64, r.rotations as f64))
+            .collect();
+        let time: Vec<(f64, f64)> = f
+            .rows
+            .iter()
+            .map(|r| (r.diameter as f64, r.steps as f64))
+            .collect();
+        let axes = ("meta-modules", "rotations");
+        panel(
+            &left,
+            "(a) rotations vs size",
+            axes,
+            &size,
+            f.rotations_vs_metas,
+        )?;
+        let axes = ("diameter (meta-modules)", "time steps");
+        panel(
+            &right,
+            "(b) time vs diameter",
+            axes,
+            &time,
+            f.steps_vs_diameter,
+        )?;
+        root.present().map_err(draw_err)?;
+        Ok(())
+    })?;
+    crate::render::save(&svg, path, 1.0)
+}
+
+/// One panel of Fig. 10: our points and their fitted line.
+fn panel(
+    area: &DrawingArea<SvgCanvas<'_>, plotters::coord::Shift>,
+    title: &str,
+    (xdesc, ydesc): (&str, &str),
+    pts: &[(f64, f64)],
+    fit: Option<crate::study::fit::LinearFit>,
+) -> Result<(), crate::render::DrawError> {
+    let xmax = pts.iter().map(|p| p.0).fold(1.0f64, f64::max) * 1.1;
+    let ymax = pts.iter().map(|p| p.1).fold(1.0f64, f64::max) * 1.15;
+    let mut chart = ChartBuilder::on(area)
+        .caption(format!("Fig. 10 {title}"), ("sans-serif", 16))
+        .margin(8)
+        .x_label_area_size(30)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..xmax, 0.0..ymax)
+        .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(xdesc)
+        .y_desc(ydesc)
+        .draw()
+        .map_err(draw_err)?;
+    chart
+        .draw_series(pts.iter().map(|&p| Circle::new(p, 5, BLUE.filled())))
+        .map_err(draw_err)?
+        .label("L -> C (ours)")
+        .legend(|(x, y)| Circle::new((x + 7, y), 5, BLUE.filled()));
+    if let Some(fit) = fit {
+        let (x0, x1) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.0), b.max(p.0))
+            });
+        chart
+            .draw_series(LineSeries::new(
+                [(x0, fit.at(x0)), (x1, fit.at(x1))],
+                RED.stroke_width(2),
+            ))
+            .map_err(draw_err)?
+            .label(format!(
+                "fit: {:.1}·x {:+.0}, R² {:.3}",
+                fit.slope, fit.intercept, fit.r2
+            ))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], RED));
+    }
+    crate::render::legend(&mut chart, SeriesLabelPosition::UpperLeft)
+}

@@ -388,3 +388,70 @@ fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
         "{err}"
     );
 }
+
+/// `repost-study --fig10` over the two smallest bundled sizes: both plan,
+/// the table has a row each with the diameter (7 and 9: the C's, the
+/// larger) and both fits, the JSON rows agree with the table, and Fig. 9
+/// refuses two scenarios (exit 2, pointing to --fig10).
+#[test]
+fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let json = common::scratch("repost-fig10", "f10.json");
+    let o = common::bin()
+        .args([
+            "repost-study",
+            "--fig10",
+            "scenarios/repost-l-to-c-20.toml",
+            "scenarios/repost-l-to-c-28.toml",
+            "--json",
+        ])
+        .arg(&json)
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.contains("time steps vs diameter: slope"), "{out}");
+    assert!(out.contains("rotations vs meta-modules: slope"), "{out}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    let diam: Vec<u64> = rows
+        .iter()
+        .map(|r| r["diameter"].as_u64().unwrap())
+        .collect();
+    assert_eq!(diam, [7, 9]);
+    for r in rows {
+        let line = format!(
+            "{:<22} {:>6} {:>8} {:>10} {:>6} {:>9}",
+            r["scenario"].as_str().unwrap(),
+            r["metas"].as_u64().unwrap(),
+            r["diameter"].as_u64().unwrap(),
+            r["iterations"].as_u64().unwrap(),
+            r["steps"].as_u64().unwrap(),
+            r["rotations"].as_u64().unwrap()
+        );
+        assert!(out.contains(&line), "{line}\n{out}");
+        assert!(r["rotations"].as_u64().unwrap() >= 10 * r["iterations"].as_u64().unwrap());
+    }
+    // Two points: the fit passes through both.
+    let fit = &v["steps_vs_diameter"];
+    assert!((fit["r2"].as_f64().unwrap() - 1.0).abs() < 1e-12, "{fit}");
+    let o = common::bin()
+        .args([
+            "repost-study",
+            "scenarios/repost-l-to-c-20.toml",
+            "scenarios/repost-l-to-c-28.toml",
+        ])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--fig10"), "{err}");
+}

@@ -195,14 +195,23 @@ impl Generator for Repost {
     }
 
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
-        let (plan, spacing_mm) = plan_scenario(scenario)?;
-        Ok(planner_schedule(&plan, spacing_mm))
+        let p = plan_scenario(scenario)?;
+        Ok(planner_schedule(&p.plan, p.spacing_mm))
     }
 }
 
-/// The plan of a `repost` scenario and its lattice spacing (mm); a goal
-/// the planner cannot reach is refused naming the goal file.
-pub fn plan_scenario(scenario: &Scenario) -> Result<(planner::Plan, f64), InputError> {
+/// A planned `repost` scenario: its shapes, the plan and the lattice
+/// spacing (mm).
+pub struct Planned {
+    pub initial: std::collections::BTreeMap<metamodule::Meta, State>,
+    pub goal: std::collections::BTreeSet<metamodule::Meta>,
+    pub plan: planner::Plan,
+    pub spacing_mm: f64,
+}
+
+/// Plans a `repost` scenario; a goal the planner cannot reach is refused
+/// naming the goal file.
+pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
     let p: PlannerParams = parameters(scenario)?;
     let (ip, gp) = (scenario.resolve(&p.initial), scenario.resolve(&p.goal));
     let initial = shape::load(&ip)?;
@@ -218,5 +227,10 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<(planner::Plan, f64), InputE
         };
         InputError::new(e.to_string()).in_file(file)
     })?;
-    Ok((plan, p.spacing_mm))
+    Ok(Planned {
+        initial,
+        goal,
+        plan,
+        spacing_mm: p.spacing_mm,
+    })
 }
