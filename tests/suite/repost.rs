@@ -455,3 +455,67 @@ fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--fig10"), "{err}");
 }
+
+/// The paper's expansion case (`scenarios/repost-expand-6x6x3.toml`): the
+/// 36 FULL bottom meta-modules are emptied, their filling catoms carried
+/// up in parallel, one streamline each, into a new top layer, in one
+/// iteration, as the paper's video shows. Every catom ends on a SPARSE
+/// loop of the 6 × 6 × 4 goal and the schedule certifies (lattice, exact
+/// sweeps of every concurrent pair).
+#[test]
+fn the_expansion_empties_every_full_meta_module_into_a_new_top_layer_in_one_iteration() {
+    use reconfcheck::algorithms::repost::metamodule::Meta;
+    use reconfcheck::algorithms::repost::shape;
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sc =
+        reconfcheck::scenario::Scenario::load(&root.join("scenarios/repost-expand-6x6x3.toml"))
+            .unwrap();
+    let s = reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.modules.len(), 1440);
+    assert_eq!(s.meta["iterations"].as_u64(), Some(1));
+    let it = &s.meta["iteration_detail"][0];
+    assert_eq!(it["streamlines"].as_array().unwrap().len(), 36, "{it}");
+    assert_eq!(it["pipelined"], true);
+    // The streamlines run together: more rotations in one step than there
+    // are streamlines.
+    assert!(s.steps.iter().any(|st| st.events.len() > 36));
+    let goal = shape::load(&root.join("models/shapes/repost/block-6x6x4.txt")).unwrap();
+    let mut want: Vec<Cell> = goal
+        .keys()
+        .flat_map(|m: &Meta| m.cells(State::Sparse))
+        .collect();
+    let mut at: std::collections::BTreeMap<u32, Cell> =
+        s.modules.iter().map(|m| (m.id, m.cell)).collect();
+    for st in &s.steps {
+        for e in &st.events {
+            if let reconfcheck::schedule::Event::Rotate { module, to, .. } = e {
+                at.insert(*module, *to);
+            }
+        }
+    }
+    let mut got: Vec<Cell> = at.into_values().collect();
+    want.sort();
+    got.sort();
+    assert_eq!(got, want);
+    let mut geometry_only = s.clone();
+    geometry_only.model = None;
+    let r = certify(&geometry_only, &Options::default()).unwrap();
+    assert!(r.certified, "{}", r.summary());
+}
+
+/// A FULL meta-module in the goal (compression) is not planned: exit 2,
+/// naming the goal file and the meta-module, never built SPARSE in silence.
+#[test]
+fn a_full_goal_meta_module_is_refused_naming_the_goal_file() {
+    let (code, err) = generate_repost(
+        "repost-full-goal",
+        &[("i.txt", "0 0 0\n4 0 0\n"), ("g.txt", "0 0 0 full\n")],
+        "i.txt",
+        "g.txt",
+    );
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("g.txt") && err.contains("FULL") && err.contains("(0, 0, 0)"),
+        "{err}"
+    );
+}

@@ -215,7 +215,17 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
     let p: PlannerParams = parameters(scenario)?;
     let (ip, gp) = (scenario.resolve(&p.initial), scenario.resolve(&p.goal));
     let initial = shape::load(&ip)?;
-    let goal: std::collections::BTreeSet<_> = shape::load(&gp)?.into_keys().collect();
+    let goal_states = shape::load(&gp)?;
+    // Filling goal meta-modules (compression) is not planned: refuse
+    // rather than build them SPARSE.
+    if let Some((m, _)) = goal_states.iter().find(|(_, st)| **st == State::Full) {
+        return Err(InputError::new(format!(
+            "goal meta-module {m} (leader cell {}) is FULL: the planner builds SPARSE goals only (filling destinations, for compression, are not implemented)",
+            m.leader()
+        ))
+        .in_file(&gp));
+    }
+    let goal: std::collections::BTreeSet<_> = goal_states.into_keys().collect();
     let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
         .expect("the FCC lattice has derived motion rules");
     let plan = planner::plan(&initial, &goal, rules).map_err(|e| {

@@ -7,7 +7,9 @@
 //!    a breadth-first spanning tree rooted at the global coordinator (a
 //!    meta-module in both shapes, the lowest), so that dismantling all of
 //!    them together leaves the rest connected; when that plan fails, only
-//!    the leaves nearest the far end of the structure (see [`plan`]).
+//!    the leaves nearest the far end of the structure (see [`plan`]). Every
+//!    FULL meta-module is a source too: its filling catoms leave, its
+//!    loop stays.
 //! 2. **Destinations**: SPARSE goal meta-modules next to an empty goal
 //!    cell; each empty goal cell goes to exactly one destination and each
 //!    destination serves one cell.
@@ -225,10 +227,17 @@ fn plan_with(
             .filter(|m| !goal.contains(m))
             .copied()
             .collect();
-        if empty.is_empty() && extra.is_empty() {
+        let full: Vec<Meta> = state
+            .iter()
+            .filter(|(_, st)| **st == State::Full)
+            .map(|(m, _)| *m)
+            .collect();
+        if empty.is_empty() && extra.is_empty() && full.is_empty() {
             return Ok(out);
         }
-        // 1. Sources: leaves of the BFS tree from the coordinator.
+        // 1. Sources: leaves of the BFS tree from the coordinator outside
+        // the goal, and every FULL meta-module (emptied to SPARSE, its
+        // loop stays: nothing disconnects).
         let (depth, children) = spanning_tree(|m| state.contains_key(m), gc);
         let mut sources: Vec<Meta> = extra
             .iter()
@@ -242,6 +251,7 @@ fn plan_with(
             let deepest = sources.iter().map(level).max().unwrap_or(0);
             sources.retain(|m| level(m) + w >= deepest);
         }
+        sources.extend(&full);
         // 2. Destinations: one per empty goal cell, lowest cells first.
         // Built bottom-up: a goal cell whose cell below is empty waits
         // (a meta-module would otherwise hang from its destination).
@@ -301,7 +311,7 @@ fn plan_with(
                     .find(|(d, _)| *d == dst)
                     .map(|(_, e)| *e)
                     .expect("a destination has its goal cell");
-                match transport(&scene, &line, goal_meta) {
+                match transport(&scene, &line, state[&src], goal_meta) {
                     Ok(paths) => {
                         // The next streamline plans against this one's end state.
                         for p in &paths {
@@ -310,7 +320,11 @@ fn plan_with(
                             scene.insert(id, b);
                         }
                         lanes.push(paths);
-                        state.remove(&src);
+                        if state[&src] == State::Full {
+                            state.insert(src, State::Sparse);
+                        } else {
+                            state.remove(&src);
+                        }
                         state.insert(goal_meta, State::Sparse);
                         planned.push(line);
                         progress = true;
@@ -378,8 +392,18 @@ fn plan_with(
 /// box grown by three cells (the ground cells of a goal beside the
 /// structure may be reachable only around it); strictly (no sliding
 /// contact) first in each. On failure, the first goal cell left unfilled.
-fn transport(scene: &Scene, line: &[Meta], goal_meta: Meta) -> Result<Vec<Vec<Hop>>, Cell> {
-    let from = line[0].sparse_cells();
+fn transport(
+    scene: &Scene,
+    line: &[Meta],
+    source: State,
+    goal_meta: Meta,
+) -> Result<Vec<Vec<Hop>>, Cell> {
+    // A FULL source gives its ten filling catoms; a SPARSE one its loop.
+    let from = if source == State::Full {
+        line[0].filling_cells()
+    } else {
+        line[0].sparse_cells()
+    };
     let targets = goal_meta.sparse_cells();
     let mut last = targets[0];
     for margin in [Some(0), Some(1), None] {
@@ -421,8 +445,9 @@ fn streamlines(
     let t = g.add_node(());
     let mut io: BTreeMap<Meta, (NodeIndex, NodeIndex)> = BTreeMap::new();
     for (m, st) in state {
-        // FULL meta-modules are never crossed.
-        if *st == State::Full {
+        // FULL meta-modules are never crossed; a FULL source only starts
+        // a streamline (no edge leads into it, below).
+        if *st == State::Full && !sources.contains(m) {
             continue;
         }
         let i = g.add_node(());
@@ -432,6 +457,9 @@ fn streamlines(
     }
     for (m, (_, o)) in &io {
         for n in adjacent(*m) {
+            if state.get(&n) == Some(&State::Full) {
+                continue;
+            }
             if let Some((i2, _)) = io.get(&n) {
                 g.add_edge(*o, *i2, 1);
             }
