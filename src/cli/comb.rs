@@ -25,6 +25,7 @@ pub struct Args {
     certify_up_to: usize,
     /// Draw the scaling plot (log–log, fits, naive baseline) to this PNG
     /// (or SVG) file.
+    #[cfg(feature = "render")]
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
     /// Also write the rows as JSON.
@@ -96,6 +97,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             });
             println!("{name} vs n: {fit}");
         }
+        #[cfg(feature = "render")]
         if let Some(p) = &a.plot {
             reconfcheck::render::comb_figures::scaling(&rows, rest, p)?;
             println!("wrote {}", p.display());

@@ -46,15 +46,11 @@ pub fn run(a: Args) -> Result<u8, Error> {
     };
     let f = study::fig9(&Scenario::load(&path)?)?;
     print!("{}", study::table(&f));
-    if let Some(p) = &a.json {
-        write_file(p, serde_json::to_string_pretty(&f).expect("serialises"))?;
-    }
     #[cfg(feature = "render")]
-    if let Some(p) = &a.plot {
-        reconfcheck::render::repost_figures::fig9(&f, p)?;
-        eprintln!("wrote {}", p.display());
-    }
-    Ok(0)
+    let draw = reconfcheck::render::repost_figures::fig9;
+    #[cfg(not(feature = "render"))]
+    let draw = std::marker::PhantomData;
+    outputs(&a, &f, draw)
 }
 
 fn fig10(a: Args) -> Result<u8, Error> {
@@ -72,13 +68,30 @@ fn fig10(a: Args) -> Result<u8, Error> {
         .collect::<Result<Vec<_>, _>>()?;
     let f = study::fig10(&scenarios, &|name| eprintln!("planning {name}…"))?;
     print!("{}", study::fig10_table(&f));
+    #[cfg(feature = "render")]
+    let draw = reconfcheck::render::repost_figures::fig10;
+    #[cfg(not(feature = "render"))]
+    let draw = std::marker::PhantomData;
+    outputs(&a, &f, draw)
+}
+
+/// How a figure is drawn to a file (nothing in a build without `render`).
+#[cfg(feature = "render")]
+type Draw<T> = fn(&T, &std::path::Path) -> Result<(), Error>;
+#[cfg(not(feature = "render"))]
+type Draw<T> = std::marker::PhantomData<T>;
+
+/// Writes the study's data as JSON and draws its figure, where asked.
+fn outputs<T: serde::Serialize>(a: &Args, data: &T, draw: Draw<T>) -> Result<u8, Error> {
     if let Some(p) = &a.json {
-        write_file(p, serde_json::to_string_pretty(&f).expect("serialises"))?;
+        write_file(p, serde_json::to_string_pretty(data).expect("serialises"))?;
     }
     #[cfg(feature = "render")]
     if let Some(p) = &a.plot {
-        reconfcheck::render::repost_figures::fig10(&f, p)?;
+        draw(data, p)?;
         eprintln!("wrote {}", p.display());
     }
+    #[cfg(not(feature = "render"))]
+    let _ = draw;
     Ok(0)
 }
