@@ -332,6 +332,20 @@ fn a_follower_catom_sets_off_before_its_leader_arrives_and_the_pipeline_certifie
     assert!(r.certified, "{}", r.summary());
 }
 
+/// Runs `cmd`, asserts exit 0 (showing both outputs otherwise) and
+/// returns its standard output.
+fn succeeds(cmd: &mut std::process::Command) -> String {
+    let o = cmd.output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    out
+}
+
 /// `repost-study` on a three-meta-module line whose end climbs onto the
 /// middle: the iteration table (with the paper's peak, 10 × streamlines),
 /// Fig. 9 drawn as a PNG, and the JSON curves, whose rotations add up to
@@ -352,21 +366,14 @@ fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
         common::scratch(tag, "f9.png"),
         common::scratch(tag, "f9.json"),
     );
-    let o = common::bin()
-        .arg("repost-study")
-        .arg(&sc)
-        .arg("--plot")
-        .arg(&png)
-        .arg("--json")
-        .arg(&json)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
+    let out = succeeds(
+        common::bin()
+            .arg("repost-study")
+            .arg(&sc)
+            .arg("--plot")
+            .arg(&png)
+            .arg("--json")
+            .arg(&json),
     );
     assert!(out.contains("Fig. 9, climb"), "{out}");
     assert!(out.contains("10×streaml."), "{out}");
@@ -405,24 +412,17 @@ fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
 fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
     let root = env!("CARGO_MANIFEST_DIR");
     let json = common::scratch("repost-fig10", "f10.json");
-    let o = common::bin()
-        .args([
-            "repost-study",
-            "--fig10",
-            "scenarios/repost-l-to-c-20.toml",
-            "scenarios/repost-l-to-c-28.toml",
-            "--json",
-        ])
-        .arg(&json)
-        .current_dir(root)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
+    let out = succeeds(
+        common::bin()
+            .args([
+                "repost-study",
+                "--fig10",
+                "scenarios/repost-l-to-c-20.toml",
+                "scenarios/repost-l-to-c-28.toml",
+                "--json",
+            ])
+            .arg(&json)
+            .current_dir(root),
     );
     assert!(out.contains("time steps vs diameter: slope"), "{out}");
     assert!(out.contains("rotations vs meta-modules: slope"), "{out}");
