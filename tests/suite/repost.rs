@@ -462,6 +462,22 @@ fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--fig10"), "{err}");
+    // An output in a folder that does not exist is refused before the
+    // minute of planning, naming the flag.
+    for flag in ["--plot", "--json"] {
+        let o = common::bin()
+            .args(["repost-study", "--fig10", flag, "no-such-folder/f.png"])
+            .current_dir(root)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(flag) && err.contains("no-such-folder"),
+            "{err}"
+        );
+        assert!(!err.contains("planning"), "{err}");
+    }
 }
 
 /// The paper's expansion case (`scenarios/repost-expand-6x6x3.toml`): the
