@@ -21,14 +21,16 @@
 //!   when it leaves.
 //!
 //! Departing at the end of everything committed is the sequential order,
-//! so the search always ends. The finished pipeline is replayed once with
-//! the certifier's anchoring rule at every step (the structure with the
-//! step's movers lifted reaches the ground); if any step fails, the caller
-//! falls back to the sequential order.
+//! so the search always ends. The finished pipeline is replayed once,
+//! checking at every step what the certifier checks: with the step's
+//! movers lifted, the catoms at rest reach the ground (the planner's
+//! [`Scene::connected_without`]); if any step fails, the caller falls back
+//! to the sequential order.
 
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
-use crate::lattice::{Cell, FccLattice, Lattice, Motion};
+use crate::lattice::config::ModuleId;
+use crate::lattice::{Cell, Motion};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 fn motion(h: &Hop) -> Motion {
@@ -49,8 +51,8 @@ struct Timeline<'a> {
     /// Start cell of a committed catom → the step it leaves at.
     departed: FxHashMap<Cell, usize>,
     /// Cells a committed catom holds after leaving its start: inclusive
-    /// step ranges (`usize::MAX`: from its arrival on).
-    visits: FxHashMap<Cell, Vec<(usize, usize)>>,
+    /// step ranges (`usize::MAX`: from its arrival on) and the catom.
+    visits: FxHashMap<Cell, Vec<(usize, usize, ModuleId)>>,
     /// Committed rotations per step.
     moves: Vec<Vec<Hop>>,
     /// The last step at which a committed rotation pivots on a cell.
@@ -67,7 +69,7 @@ impl Timeline<'_> {
         }
         self.visits
             .get(&c)
-            .is_some_and(|v| v.iter().any(|&(a, b)| a <= t && t <= b))
+            .is_some_and(|v| v.iter().any(|&(a, b, _)| a <= t && t <= b))
     }
 
     fn moves_at(&self, t: usize) -> &[Hop] {
@@ -128,10 +130,11 @@ impl Timeline<'_> {
             return;
         };
         self.departed.insert(start, t0);
+        let id = self.base.at[&start];
         for (j, h) in path.iter().enumerate() {
             let t = t0 + j;
             if j > 0 {
-                self.visits.entry(h.from).or_default().push((t, t));
+                self.visits.entry(h.from).or_default().push((t, t, id));
             }
             if self.moves.len() <= t {
                 self.moves.resize_with(t + 1, Vec::new);
@@ -143,41 +146,31 @@ impl Timeline<'_> {
         self.visits
             .entry(last.to)
             .or_default()
-            .push((t0 + path.len(), usize::MAX));
+            .push((t0 + path.len(), usize::MAX, id));
     }
 
     /// Whether, with the movers of step `t` lifted (and `leaving`, a catom
-    /// about to move then), every catom at rest reaches the ground
-    /// through latched neighbours: the certifier's anchoring rule.
+    /// about to move then), every catom at rest stays anchored: the
+    /// planner's own rule ([`Scene::connected_without`]) on the catoms at
+    /// rest at the start of step `t`, as the certifier judges a step.
     fn anchored(&self, t: usize, leaving: Option<Cell>) -> bool {
-        let Some(g) = self.base.ground else {
-            return true;
-        };
         let lifted: FxHashSet<Cell> = self
             .moves_at(t)
             .iter()
             .map(|h| h.from)
             .chain(leaving)
             .collect();
-        let rest: FxHashSet<Cell> = self
-            .base
-            .at
-            .keys()
-            .chain(self.visits.keys())
-            .copied()
-            .filter(|c| !lifted.contains(c) && self.occupied(*c, t))
-            .collect();
-        let l = FccLattice;
-        let mut stack: Vec<Cell> = rest.iter().copied().filter(|c| c.z == g).collect();
-        let mut seen: FxHashSet<Cell> = stack.iter().copied().collect();
-        while let Some(c) = stack.pop() {
-            for n in l.neighbours(c) {
-                if rest.contains(&n) && seen.insert(n) {
-                    stack.push(n);
-                }
+        let mut rest = self.base.clone();
+        rest.at
+            .retain(|c, _| !lifted.contains(c) && self.occupied(*c, t));
+        for (c, v) in &self.visits {
+            if let Some(&(_, _, id)) = v.iter().find(|&&(a, b, _)| a <= t && t <= b)
+                && !lifted.contains(c)
+            {
+                rest.insert(id, *c);
             }
         }
-        seen.len() == rest.len()
+        rest.connected_without(None)
     }
 }
 
@@ -190,7 +183,8 @@ pub struct Pipelined {
 }
 
 /// The catoms of each lane (one path per catom, in the order planned)
-/// pipelined and the lanes side by side; `None` when the pipeline does not
+/// pipelined and the lanes side by side; `None` when a catom fits
+/// nowhere (not even after everything committed) or the pipeline does not
 /// pass the anchoring replay.
 pub fn pipeline(
     before: &Scene,

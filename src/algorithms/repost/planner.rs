@@ -84,7 +84,7 @@ pub struct Iteration {
     pub steps: usize,
     pub motions: usize,
     /// Whether the streamlines ran pipelined ([`super::pipeline`]) or,
-    /// the pipeline failing its anchoring replay, one catom at a time.
+    /// the pipeline failing, one catom at a time.
     pub pipelined: bool,
 }
 
@@ -354,20 +354,24 @@ fn plan_with(
         let streamlines = planned;
         let motions: usize = lanes.iter().flatten().map(Vec::len).sum();
         scene = before.clone();
-        let pipelined = pipeline(&before, &lanes, rules);
-        let is_pipelined = pipelined.is_some();
-        if let Some(p) = pipelined {
-            emit(&mut scene, p.steps, p.lanes_at, &mut out);
-        } else {
-            // The pipeline left the structure unanchored at some step: run
-            // the streamlines one after another, the order they were
-            // planned in (valid by construction).
-            for lane in lanes {
-                let steps: Vec<Vec<Hop>> = lane.into_iter().flatten().map(|h| vec![h]).collect();
-                let n = steps.len();
-                emit(&mut scene, steps, vec![1; n], &mut out);
+        let pipelined = match pipeline(&before, &lanes, rules) {
+            Some(p) => {
+                emit(&mut scene, p.steps, p.lanes_at, &mut out);
+                true
             }
-        }
+            None => {
+                // No pipeline (a catom that fits nowhere, or a step left
+                // unanchored): run the streamlines one after another, the
+                // order they were planned in (valid by construction).
+                for lane in lanes {
+                    let steps: Vec<Vec<Hop>> =
+                        lane.into_iter().flatten().map(|h| vec![h]).collect();
+                    let n = steps.len();
+                    emit(&mut scene, steps, vec![1; n], &mut out);
+                }
+                false
+            }
+        };
         out.iterations.push(Iteration {
             sources,
             destinations: streamlines
@@ -380,7 +384,7 @@ fn plan_with(
             steps: out.steps.len() - first_step,
             first_step,
             motions,
-            pipelined: is_pipelined,
+            pipelined,
             streamlines: streamlines.clone(),
         });
     }
