@@ -69,7 +69,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         m = m.with_connector(pressure, a.bending.unwrap_or(m.connector.bending));
     }
     if let Some(p) = &a.html {
-        super::html::check_path(p)?;
+        super::output::check_output("--html", p)?;
     }
     let (lo, hi) = b_study::default_range(&a.family);
     let (b_min, b_max) = (a.b_min.unwrap_or(lo), a.b_max.unwrap_or(hi));

@@ -10,32 +10,6 @@ use reconfcheck::schedule::Schedule;
 use reconfcheck::study::b_study::Study;
 use std::path::Path;
 
-/// Refuses an `--html` path whose folder does not exist before any work is
-/// done: a certification of the sandcastle takes minutes, and its page
-/// should not be lost to a typo (exit 2, the flag's error).
-pub fn check_path(path: &Path) -> Result<(), Error> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if path.is_dir() {
-        return Err(InputError::new(format!(
-            "--html {}: is a folder, not a file",
-            path.display()
-        ))
-        .into());
-    }
-    if !dir.is_dir() {
-        return Err(InputError::new(format!(
-            "--html {}: cannot write the report there: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        ))
-        .into());
-    }
-    Ok(())
-}
-
 /// Writes the page of a certification of `s` (read from `origin`): the
 /// replay, the report, and where the mechanics ran the load maps
 /// ([`html::load_maps`]: every step where they fit).

@@ -118,7 +118,7 @@ fn print_range_time(r: &certify::RangeDone) {
 pub fn certify_and_report(s: &Schedule, origin: &Path, args: &ReportArgs) -> Result<u8, Error> {
     let opts = args.options(origin)?;
     if let Some(p) = &args.html {
-        super::html::check_path(p)?;
+        super::output::check_output("--html", p)?;
     }
     let tolerance = reconfcheck::number::within(args.baseline_tolerance, 0.0, f64::MAX, "≥ 0")
         .map_err(|e| InputError::new(format!("--baseline-tolerance: {e}")))?;

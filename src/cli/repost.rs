@@ -31,9 +31,13 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<u8, Error> {
-    writable(a.json.as_deref(), "--json")?;
+    if let Some(p) = &a.json {
+        super::output::check_output("--json", p)?;
+    }
     #[cfg(feature = "render")]
-    writable(a.plot.as_deref(), "--plot")?;
+    if let Some(p) = &a.plot {
+        super::output::check_output("--plot", p)?;
+    }
     if a.fig10 {
         return fig10(a);
     }
@@ -97,21 +101,4 @@ fn outputs<T: serde::Serialize>(a: &Args, data: &T, draw: Draw<T>) -> Result<u8,
     #[cfg(not(feature = "render"))]
     let _ = draw;
     Ok(0)
-}
-
-/// Refuses an output whose folder does not exist before the planning runs
-/// (Fig. 10 plans for a minute): exit 2 naming the flag and the path.
-fn writable(path: Option<&std::path::Path>, flag: &str) -> Result<(), Error> {
-    let Some(p) = path else {
-        return Ok(());
-    };
-    match p.parent() {
-        Some(d) if !d.as_os_str().is_empty() && !d.is_dir() => Err(InputError::new(format!(
-            "{flag} {}: no such folder {} (create it first)",
-            p.display(),
-            d.display()
-        ))
-        .into()),
-        _ => Ok(()),
-    }
 }
