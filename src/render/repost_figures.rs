@@ -86,38 +86,43 @@ pub fn fig9(f: &Fig9, path: &Path) -> Result<(), Error> {
     crate::render::save(&svg, path, 1.0)
 }
 
-/// Draws Fig. 10 as PNG (or SVG): rotations against meta-modules, and time
-/// steps against the diameter, each with its least-squares line.
+/// Draws Fig. 10 as PNG (or SVG): the paper's two panels, messages
+/// against rotations and time steps against the diameter, then rotations
+/// against meta-modules, each with its least-squares line.
 pub fn fig10(f: &crate::study::repost::Fig10, path: &Path) -> Result<(), Error> {
     let svg = crate::render::svg(path, |svg| {
-        let root = SvgCanvas::with_string(svg, (900, 400)).into_drawing_area();
+        let root = SvgCanvas::with_string(svg, (1350, 400)).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
-        let (left, right) = root.split_horizontally(450);
-        let size: Vec<(f64, f64)> = f
-            .rows
-            .iter()
-            .map(|r| (r.metas as f64, r.rotations as f64))
-            .collect();
-        let time: Vec<(f64, f64)> = f
-            .rows
-            .iter()
-            .map(|r| (r.diameter as f64, r.steps as f64))
-            .collect();
-        let axes = ("meta-modules", "rotations");
+        let areas = root.split_evenly((1, 3));
+        let pts = |g: &dyn Fn(&crate::study::repost::SizeRow) -> (usize, usize)| {
+            f.rows
+                .iter()
+                .map(|r| {
+                    let (x, y) = g(r);
+                    (x as f64, y as f64)
+                })
+                .collect::<Vec<_>>()
+        };
         panel(
-            &left,
-            "(a) rotations vs size",
-            axes,
-            &size,
-            f.rotations_vs_metas,
+            &areas[0],
+            "(a) messages vs motions",
+            ("rotations", "messages (model)"),
+            &pts(&|r| (r.rotations, r.messages.total())),
+            f.messages_vs_rotations,
         )?;
-        let axes = ("diameter (meta-modules)", "time steps");
         panel(
-            &right,
+            &areas[1],
             "(b) time vs diameter",
-            axes,
-            &time,
+            ("diameter (meta-modules)", "time steps"),
+            &pts(&|r| (r.diameter, r.steps)),
             f.steps_vs_diameter,
+        )?;
+        panel(
+            &areas[2],
+            "(c) rotations vs size",
+            ("meta-modules", "rotations"),
+            &pts(&|r| (r.metas, r.rotations)),
+            f.rotations_vs_metas,
         )?;
         root.present().map_err(draw_err)?;
         Ok(())
@@ -144,6 +149,9 @@ fn panel(
         .map_err(draw_err)?;
     chart
         .configure_mesh()
+        .x_labels(6)
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y:.0}"))
         .x_desc(xdesc)
         .y_desc(ydesc)
         .draw()

@@ -8,11 +8,14 @@
 //! dismantled sources moves at once.
 //!
 //! Fig. 10: the L → C reconfiguration at several sizes; time steps
-//! against the configuration's diameter (the paper: linear) and rotations
-//! against size, with least-squares fits. Messages, the paper's Fig. 10a,
-//! are not counted: the planner is centralised.
+//! against the configuration's diameter (the paper: linear), messages
+//! against rotations (the paper: proportional; the messages are what the
+//! authors' distributed protocol would send to carry out the plan,
+//! [`crate::algorithms::repost::messages`]) and rotations against size,
+//! with least-squares fits.
 
 use super::fit::{LinearFit, linear_fit};
+use crate::algorithms::repost::messages::Messages;
 use crate::algorithms::repost::metamodule::{Direction, Meta};
 use crate::algorithms::repost::{plan_scenario, planner::Plan};
 use crate::error::InputError;
@@ -36,9 +39,11 @@ pub struct IterationRow {
     pub peak: usize,
     /// Rotations per step, on average over the iteration.
     pub mean: f64,
-    /// Whether the catoms ran pipelined or (the pipeline failing its
-    /// anchoring replay) one at a time.
+    /// Whether the catoms ran pipelined or (a catom fitting nowhere in
+    /// the pipeline) one at a time.
     pub pipelined: bool,
+    /// What the distributed protocol would send (all phases).
+    pub messages: usize,
 }
 
 /// Fig. 9's two curves and the iteration table.
@@ -83,6 +88,8 @@ pub struct SizeRow {
     pub iterations: usize,
     pub steps: usize,
     pub rotations: usize,
+    /// Summed over the iterations, by phase.
+    pub messages: Messages,
 }
 
 /// Fig. 10's rows and fits.
@@ -93,6 +100,8 @@ pub struct Fig10 {
     pub steps_vs_diameter: Option<LinearFit>,
     /// Rotations against the meta-module count.
     pub rotations_vs_metas: Option<LinearFit>,
+    /// Messages against rotations (the paper's Fig. 10a).
+    pub messages_vs_rotations: Option<LinearFit>,
 }
 
 /// The graph diameter of a shape: the longest of the shortest
@@ -134,12 +143,23 @@ pub fn fig10(scenarios: &[Scenario], progress: &dyn Fn(&str)) -> Result<Fig10, I
             iterations: p.plan.iterations.len(),
             steps: p.plan.steps.len(),
             rotations: p.plan.steps.iter().map(Vec::len).sum(),
+            messages: p
+                .plan
+                .iterations
+                .iter()
+                .fold(Messages::default(), |mut a, it| {
+                    a += it.messages;
+                    a
+                }),
         });
     }
     let pts = |f: &dyn Fn(&SizeRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
     Ok(Fig10 {
         steps_vs_diameter: linear_fit(&pts(&|r| (r.diameter as f64, r.steps as f64))),
         rotations_vs_metas: linear_fit(&pts(&|r| (r.metas as f64, r.rotations as f64))),
+        messages_vs_rotations: linear_fit(&pts(&|r| {
+            (r.rotations as f64, r.messages.total() as f64)
+        })),
         rows,
     })
 }
@@ -150,14 +170,35 @@ pub fn fig10_table(f: &Fig10) -> String {
     let _ = writeln!(s, "Fig. 10: L -> C at several sizes");
     let _ = writeln!(
         s,
-        "{:<22} {:>6} {:>8} {:>10} {:>6} {:>9}",
-        "scenario", "metas", "diameter", "iterations", "steps", "rotations"
+        "{:<22} {:>6} {:>8} {:>10} {:>6} {:>9} {:>9} {:>7} {:>8} {:>7} {:>9}",
+        "scenario",
+        "metas",
+        "diameter",
+        "iterations",
+        "steps",
+        "rotations",
+        "messages",
+        "tree",
+        "max-flow",
+        "termin.",
+        "transport"
     );
     for r in &f.rows {
+        let m = &r.messages;
         let _ = writeln!(
             s,
-            "{:<22} {:>6} {:>8} {:>10} {:>6} {:>9}",
-            r.scenario, r.metas, r.diameter, r.iterations, r.steps, r.rotations
+            "{:<22} {:>6} {:>8} {:>10} {:>6} {:>9} {:>9} {:>7} {:>8} {:>7} {:>9}",
+            r.scenario,
+            r.metas,
+            r.diameter,
+            r.iterations,
+            r.steps,
+            r.rotations,
+            m.total(),
+            m.tree,
+            m.max_flow,
+            m.termination,
+            m.transport
         );
     }
     let line = |name: &str, fit: &Option<LinearFit>| match fit {
@@ -169,6 +210,7 @@ pub fn fig10_table(f: &Fig10) -> String {
     };
     s += &line("time steps vs diameter", &f.steps_vs_diameter);
     s += &line("rotations vs meta-modules", &f.rotations_vs_metas);
+    s += &line("messages vs rotations", &f.messages_vs_rotations);
     s
 }
 
@@ -190,6 +232,7 @@ pub fn from_plan(name: &str, plan: &Plan) -> Fig9 {
                 peak: m.iter().copied().max().unwrap_or(0),
                 mean: m.iter().sum::<usize>() as f64 / it.steps.max(1) as f64,
                 pipelined: it.pipelined,
+                messages: it.messages.total(),
             }
         })
         .collect();
@@ -212,7 +255,7 @@ pub fn table(f: &Fig9) -> String {
     );
     let _ = writeln!(
         s,
-        "{:>4} {:>6} {:>6} {:>9} {:>11} {:>5} {:>11} {:>6} {:>9}",
+        "{:>4} {:>6} {:>6} {:>9} {:>11} {:>5} {:>11} {:>6} {:>9} {:>9}",
         "it",
         "first",
         "steps",
@@ -221,12 +264,13 @@ pub fn table(f: &Fig9) -> String {
         "peak",
         "10×streaml.",
         "mean",
-        "pipelined"
+        "pipelined",
+        "messages"
     );
     for r in &f.iterations {
         let _ = writeln!(
             s,
-            "{:>4} {:>6} {:>6} {:>9} {:>11} {:>5} {:>11} {:>6.2} {:>9}",
+            "{:>4} {:>6} {:>6} {:>9} {:>11} {:>5} {:>11} {:>6.2} {:>9} {:>9}",
             r.iteration,
             r.first_step + 1,
             r.steps,
@@ -235,7 +279,8 @@ pub fn table(f: &Fig9) -> String {
             r.peak,
             CATOMS_PER_META * r.streamlines,
             r.mean,
-            if r.pipelined { "yes" } else { "no" }
+            if r.pipelined { "yes" } else { "no" },
+            r.messages
         );
     }
     let total: usize = f.motions.iter().sum();

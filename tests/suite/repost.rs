@@ -445,8 +445,23 @@ fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
             r["rotations"].as_u64().unwrap()
         );
         assert!(out.contains(&line), "{line}\n{out}");
-        assert!(r["rotations"].as_u64().unwrap() >= 10 * r["iterations"].as_u64().unwrap());
+        let rotations = r["rotations"].as_u64().unwrap();
+        assert!(rotations >= 10 * r["iterations"].as_u64().unwrap());
+        // Fig. 10a: every phase of the protocol sends messages, the table
+        // prints their sum, and motion coordination costs at least one
+        // message per rotation (its Coordinate or its latching points).
+        let m = &r["messages"];
+        let parts =
+            ["tree", "max_flow", "termination", "transport"].map(|k| m[k].as_u64().unwrap());
+        assert!(parts.iter().all(|&p| p > 0), "{m}");
+        let total: u64 = parts.iter().sum();
+        assert!(
+            out.contains(&format!("{line} {total:>9}")),
+            "{total}\n{out}"
+        );
+        assert!(parts[3] >= rotations && parts[3] <= 30 * rotations, "{m}");
     }
+    assert!(out.contains("messages vs rotations: slope"), "{out}");
     // Two points: the fit passes through both.
     let fit = &v["steps_vs_diameter"];
     assert!((fit["r2"].as_f64().unwrap() - 1.0).abs() < 1e-12, "{fit}");

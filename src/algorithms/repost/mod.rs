@@ -13,6 +13,7 @@
 //! schedule, one rotation per time step; `repost` plans a reconfiguration
 //! between two meta-module shape files ([`shape`]).
 
+pub mod messages;
 pub mod metamodule;
 pub mod operations;
 pub mod pipeline;

@@ -16,16 +16,18 @@
 //! * the catom as an obstacle: its cell at the start of every step of its
 //!   path, and its goal cell from its arrival on, must not block a
 //!   committed rotation of that step;
-//! * its start cell, once left, is not a committed rotation's pivot later,
-//!   and the structure, its movers lifted, stays anchored to the ground
-//!   when it leaves.
+//! * its start cell, once left, is not a committed rotation's pivot later;
+//! * the structure stays anchored to the ground, as the certifier judges
+//!   a step (the step's movers lifted, every catom at rest reaches the
+//!   ground: the planner's [`Scene::connected_without`]), at its departure
+//!   *and at every later step*: a catom that leaves while a later mover
+//!   is still at rest can cut what that mover holds up once it moves too.
 //!
 //! Departing at the end of everything committed is the sequential order,
-//! so the search always ends. The finished pipeline is replayed once,
-//! checking at every step what the certifier checks: with the step's
-//! movers lifted, the catoms at rest reach the ground (the planner's
-//! [`Scene::connected_without`]); if any step fails, the caller falls back
-//! to the sequential order.
+//! so the search always ends. A commit only empties its start cell from
+//! its departure on and fills its goal after its arrival, so checking the
+//! steps from its departure to the end keeps every step of the timeline
+//! anchored; a debug assertion replays the finished timeline to say so.
 
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
@@ -121,8 +123,9 @@ impl Timeline<'_> {
             }
         }
         let goal = path.last().map_or(start, |h| h.to);
-        (t0 + path.len()..self.moves.len()).all(|t| self.spares(goal, start, t))
-            && self.anchored(t0, Some(start))
+        let end = t0 + path.len();
+        (end..self.moves.len()).all(|t| self.spares(goal, start, t))
+            && (t0..self.moves.len().max(end)).all(|t| self.anchored(t, Some(start)))
     }
 
     fn commit(&mut self, start: Cell, path: &[Hop], t0: usize) {
@@ -184,8 +187,8 @@ pub struct Pipelined {
 
 /// The catoms of each lane (one path per catom, in the order planned)
 /// pipelined and the lanes side by side; `None` when a catom fits
-/// nowhere (not even after everything committed) or the pipeline does not
-/// pass the anchoring replay.
+/// nowhere (not even after everything committed; the sequential plan
+/// makes that impossible unless the planner and the rules disagree).
 pub fn pipeline(
     before: &Scene,
     lanes: &[Vec<Vec<Hop>>],
@@ -217,9 +220,10 @@ pub fn pipeline(
         }
         spans.extend(span);
     }
-    if !(0..tl.moves.len()).all(|t| tl.anchored(t, None)) {
-        return None;
-    }
+    debug_assert!(
+        (0..tl.moves.len()).all(|t| tl.anchored(t, None)),
+        "every commit checks the steps its absence affects"
+    );
     let lanes_at = (0..tl.moves.len())
         .map(|t| spans.iter().filter(|(a, b)| *a <= t && t <= *b).count())
         .collect();
@@ -227,4 +231,124 @@ pub fn pipeline(
         steps: tl.moves,
         lanes_at,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::Route;
+
+    /// Rules that allow every rotation and every pair: what is left to the
+    /// timeline is occupancy, pivots and anchoring.
+    struct Free;
+    impl MotionRules for Free {
+        fn blocking_cells(&self, _: &Motion) -> Vec<Cell> {
+            Vec::new()
+        }
+        fn touched_cells(&self, _: &Motion) -> Vec<Cell> {
+            Vec::new()
+        }
+        fn concurrent_clear(&self, _: &Motion, _: &Motion) -> bool {
+            true
+        }
+    }
+
+    fn c(x: i32, y: i32) -> Cell {
+        Cell::new(x, y, 5)
+    }
+
+    fn hop(from: Cell, to: Cell, pivot: Cell) -> Hop {
+        Hop {
+            from,
+            to,
+            pivot,
+            route: Route::Hexagonal,
+        }
+    }
+
+    /// The catoms at rest at the start of each step, movers lifted, all
+    /// reach the fixed catom (a breadth-first search written here).
+    fn every_step_anchored(before: &Scene, steps: &[Vec<Hop>]) -> Vec<bool> {
+        let mut at: FxHashSet<Cell> = before.at.keys().copied().collect();
+        let anchor = c(0, 0);
+        steps
+            .iter()
+            .map(|step| {
+                let rest: FxHashSet<Cell> = at
+                    .iter()
+                    .copied()
+                    .filter(|x| step.iter().all(|h| h.from != *x))
+                    .collect();
+                let mut seen = FxHashSet::from_iter([anchor]);
+                let mut stack = vec![anchor];
+                while let Some(x) = stack.pop() {
+                    for n in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+                        let y = c(x.x + n.0, x.y + n.1);
+                        if rest.contains(&y) && seen.insert(y) {
+                            stack.push(y);
+                        }
+                    }
+                }
+                for h in step {
+                    at.remove(&h.from);
+                    at.insert(h.to);
+                }
+                seen.len() == rest.len()
+            })
+            .collect()
+    }
+
+    /// In one layer, F (fixed) holds R, R2 and S up through two routes:
+    /// M, and K–Z. Lane 1 sends M0 round F, then M (leaving at step 1)
+    /// to the cell beside M0 and S, which gives R a route again from
+    /// step 2; lane 2 sends Z away for good. Leaving at step 0 is fine
+    /// *at* step 0 (M still holds R), but at step 1 M is a mover and Z is
+    /// gone: R, R2 and S would hang from nothing. Z must wait until M has
+    /// arrived.
+    #[test]
+    fn a_catom_waits_until_its_absence_cannot_cut_the_structure_at_a_later_step() {
+        let [f, k, m, z, r, r2, s, m0] = [
+            (0, 0),
+            (0, 1),
+            (1, 0),
+            (1, 1),
+            (2, 0),
+            (2, 1),
+            (2, -1),
+            (-1, 0),
+        ]
+        .map(|(x, y)| c(x, y));
+        let mut before = Scene {
+            at: FxHashMap::default(),
+            fixed: FxHashSet::default(),
+            ground: None,
+            lo: c(-5, -5),
+            hi: c(5, 5),
+            region: None,
+        };
+        for (i, x) in [f, k, m, z, r, r2, s, m0].into_iter().enumerate() {
+            before.insert(i as ModuleId, x);
+        }
+        before.fixed.insert(0);
+        let lane1 = vec![vec![hop(m0, c(0, -1), f)], vec![hop(m, c(1, -1), f)]];
+        let z_path = vec![hop(z, c(1, 2), k), hop(c(1, 2), c(0, 2), k)];
+        let p = pipeline(&before, &[lane1, vec![z_path.clone()]], &Free)
+            .expect("Z fits once M has arrived");
+        let z_leaves = p.steps.iter().position(|st| st.iter().any(|h| h.from == z));
+        assert_eq!(z_leaves, Some(2), "Z leaves when M is in place again");
+        assert!(every_step_anchored(&before, &p.steps).iter().all(|&a| a));
+        // Leaving at step 0, as a departure-only check allowed, cuts step 1.
+        let mut early: Vec<Vec<Hop>> = p
+            .steps
+            .iter()
+            .map(|st| st.iter().filter(|h| !z_path.contains(h)).copied().collect())
+            .collect();
+        early[0].push(z_path[0]);
+        early[1].push(z_path[1]);
+        assert_eq!(
+            every_step_anchored(&before, &early)[..3],
+            [true, false, true],
+            "leaving at step 0 hangs R, R2 and S from nothing at step 1"
+        );
+    }
 }

@@ -23,9 +23,10 @@
 //!    each planned against the end state of the ones before it
 //!    ([`super::operations::move_catoms`]); then they run pipelined, one
 //!    behind another, the streamlines side by side
-//!    ([`super::pipeline`]), or one at a time if the pipeline fails its
-//!    anchoring replay.
+//!    ([`super::pipeline`]), or one at a time if a catom fits nowhere in
+//!    the pipeline.
 
+use super::messages::{self, IterationRecord, Messages};
 use super::metamodule::{Meta, State};
 use super::operations::move_catoms;
 use super::pipeline::pipeline;
@@ -86,6 +87,9 @@ pub struct Iteration {
     /// Whether the streamlines ran pipelined ([`super::pipeline`]) or,
     /// the pipeline failing, one catom at a time.
     pub pipelined: bool,
+    /// What the paper's distributed protocol sends to do the same
+    /// ([`super::messages`]).
+    pub messages: Messages,
 }
 
 /// The plan: the initial catoms and the steps of rotations.
@@ -284,6 +288,7 @@ fn plan_with(
         // a neighbour that a later iteration dismantles first).
         let first_step = out.steps.len();
         let before = scene.clone();
+        let present = state.clone();
         let mut lanes: Vec<Vec<Vec<Hop>>> = Vec::new();
         let mut planned: Vec<Vec<Meta>> = Vec::new();
         let mut deferred: FxHashSet<Meta> = FxHashSet::default();
@@ -360,8 +365,7 @@ fn plan_with(
                 true
             }
             None => {
-                // No pipeline (a catom that fits nowhere, or a step left
-                // unanchored): run the streamlines one after another, the
+                // No pipeline (a catom that fits nowhere): run the streamlines one after another, the
                 // order they were planned in (valid by construction).
                 for lane in lanes {
                     let steps: Vec<Vec<Hop>> =
@@ -372,7 +376,16 @@ fn plan_with(
                 false
             }
         };
+        let messages = messages::count(&IterationRecord {
+            present: &present,
+            coordinator: gc,
+            sources: &sources,
+            streamlines: &streamlines,
+            cells: &before.at,
+            steps: &out.steps[first_step..],
+        });
         out.iterations.push(Iteration {
+            messages,
             sources,
             destinations: streamlines
                 .iter()
