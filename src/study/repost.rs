@@ -139,7 +139,7 @@ pub fn fig10(scenarios: &[Scenario], progress: &dyn Fn(&str)) -> Result<Fig10, I
         rows.push(SizeRow {
             scenario: sc.name.clone(),
             metas: start.len(),
-            diameter: diameter(&start).max(diameter(&p.goal)),
+            diameter: diameter(&start).max(diameter(&p.goal.keys().copied().collect())),
             iterations: p.plan.iterations.len(),
             steps: p.plan.steps.len(),
             rotations: p.plan.steps.iter().map(Vec::len).sum(),

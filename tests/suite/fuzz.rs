@@ -3,8 +3,8 @@
 //! element deleted, a step duplicated) are either refused as input errors
 //! naming the file or certified with a verdict — through every check,
 //! collision sweeps and mechanics included. The same for the shape files:
-//! character-level edits of a CSG file and of a 2D grid file are refused or
-//! parsed; and for the scenarios: each generator's parameters, edited, are
+//! character-level edits of a CSG file, of a 2D grid file and of a RePoSt
+//! meta-module shape file are refused or parsed; and for the scenarios: each generator's parameters, edited, are
 //! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test suite fuzz::` searches longer.
 
 use proptest::prelude::*;
@@ -285,6 +285,32 @@ proptest! {
         match outcome {
             Ok(Ok(_)) => {}
             Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.txt") || e.file.is_none(), "{e}"),
+            Err(_) => prop_assert!(false, "panicked on {edited:?}"),
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(config(256))]
+
+    /// The meta-module shape files of seed 001: an edited FULL-bottom
+    /// block is refused naming the file, or loads to meta-modules on the
+    /// lattice that write back to the same shape.
+    #[test]
+    fn edited_repost_shape_files_are_refused_or_loaded_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+    ) {
+        use reconfcheck::algorithms::repost::shape;
+        let edited = edited_model("models/shapes/repost/block-2x2x3-full-bottom.txt", &edits);
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            shape::parse(&edited, Path::new("edited.txt")).map(|m| {
+                let again = shape::parse(&shape::to_text(&m), Path::new("again.txt"));
+                (m.clone(), again.ok())
+            })
+        }));
+        match outcome {
+            Ok(Ok((m, again))) => prop_assert_eq!(Some(m), again),
+            Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.txt"), "{e}"),
             Err(_) => prop_assert!(false, "panicked on {edited:?}"),
         }
     }

@@ -184,16 +184,16 @@ fn a_goal_outside_the_compression_bound_exits_2_naming_the_bound() {
 }
 
 /// Replays the schedule's rotations and asserts that the catoms end
-/// exactly on the SPARSE loops of the goal shape `file`
-/// (`models/shapes/repost/`).
-fn ends_on_the_goal_loops(s: &reconfcheck::schedule::Schedule, file: &str) {
+/// exactly on the goal shape `file` (`models/shapes/repost/`): the loops
+/// of its meta-modules, and the interiors of its FULL ones.
+fn ends_on_the_goal(s: &reconfcheck::schedule::Schedule, file: &str) {
     use reconfcheck::algorithms::repost::metamodule::Meta;
     use reconfcheck::algorithms::repost::shape;
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let goal = shape::load(&root.join("models/shapes/repost").join(file)).unwrap();
     let mut want: Vec<Cell> = goal
-        .keys()
-        .flat_map(|m: &Meta| m.cells(State::Sparse))
+        .iter()
+        .flat_map(|(m, st): (&Meta, &State)| m.cells(*st))
         .collect();
     let mut at: std::collections::BTreeMap<u32, Cell> =
         s.modules.iter().map(|m| (m.id, m.cell)).collect();
@@ -231,7 +231,7 @@ fn the_l_to_c_planner_completes_and_its_schedule_is_collision_free() {
         "{:?}",
         s.meta["source_width"]
     );
-    ends_on_the_goal_loops(&s, "c-48.txt");
+    ends_on_the_goal(&s, "c-48.txt");
     // The streamlines run pipelined: every iteration, and several catoms
     // per step (one at a time would be 7,186 steps).
     let detail = s.meta["iteration_detail"].as_array().unwrap();
@@ -516,26 +516,63 @@ fn the_expansion_empties_every_full_meta_module_into_a_new_top_layer_in_one_iter
     // The streamlines run together: more rotations in one step than there
     // are streamlines.
     assert!(s.steps.iter().any(|st| st.events.len() > 36));
-    ends_on_the_goal_loops(&s, "block-6x6x4.txt");
+    ends_on_the_goal(&s, "block-6x6x4.txt");
     let mut geometry_only = s.clone();
     geometry_only.model = None;
     let r = certify(&geometry_only, &Options::default()).unwrap();
     assert!(r.certified, "{}", r.summary());
 }
 
-/// A FULL meta-module in the goal (compression) is not planned: exit 2,
-/// naming the goal file and the meta-module, never built SPARSE in silence.
+/// A goal whose loops and fillings do not hold exactly the initial catoms
+/// cannot be reached: exit 2, naming the goal file and both counts.
 #[test]
-fn a_full_goal_meta_module_is_refused_naming_the_goal_file() {
+fn a_goal_that_holds_a_different_number_of_catoms_is_refused_naming_the_goal_file() {
     let (code, err) = generate_repost(
-        "repost-full-goal",
-        &[("i.txt", "0 0 0\n4 0 0\n"), ("g.txt", "0 0 0 full\n")],
+        "repost-catoms",
+        &[
+            ("i.txt", "0 0 0\n4 0 0\n8 0 0\n"),
+            ("g.txt", "0 0 0 full\n4 0 0 full\n"),
+        ],
         "i.txt",
         "g.txt",
     );
     assert_eq!(code, Some(2), "{err}");
     assert!(
-        err.contains("g.txt") && err.contains("FULL") && err.contains("(0, 0, 0)"),
+        err.contains("g.txt") && err.contains("hold 40 catoms") && err.contains("initial shape 30"),
         "{err}"
     );
+}
+
+/// Compression (filling destinations, §V-A), at its smallest: the
+/// expansion case reversed, 2 × 2 × 4 SPARSE → 2 × 2 × 3 with a FULL
+/// bottom. Each iteration's destinations are the meta-modules being
+/// filled, the catoms end on the goal's loops and in its FULL interiors,
+/// and the schedule certifies (lattice, exact sweeps of every concurrent
+/// pair).
+#[test]
+fn compression_fills_the_bottom_meta_modules_with_the_top_layer() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sc =
+        reconfcheck::scenario::Scenario::load(&root.join("scenarios/repost-compress-2x2x4.toml"))
+            .unwrap();
+    let s = reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.modules.len(), 160);
+    let its = s.meta["iteration_detail"].as_array().unwrap();
+    let mut filled = Vec::new();
+    for it in its {
+        for d in it["destinations"].as_array().unwrap() {
+            assert_eq!(d[0], d[1], "a filling destination is its own goal: {it}");
+            assert_eq!(d[0]["z"], 0, "{it}");
+            filled.push(d[0].clone());
+        }
+        for src in it["sources"].as_array().unwrap() {
+            assert_eq!(src["z"], 3, "{it}");
+        }
+    }
+    assert_eq!(filled.len(), 4, "each bottom meta-module filled once");
+    ends_on_the_goal(&s, "block-2x2x3-full-bottom.txt");
+    let mut geometry_only = s.clone();
+    geometry_only.model = None;
+    let r = certify(&geometry_only, &Options::default()).unwrap();
+    assert!(r.certified, "{}", r.summary());
 }

@@ -133,7 +133,7 @@ impl Generator for RepostOperation {
 pub struct PlannerParams {
     /// Initial shape file (relative to the scenario).
     pub initial: String,
-    /// Goal shape file; its states are ignored (the goal is a set of cells).
+    /// Goal shape file; a FULL meta-module there is filled (compression).
     pub goal: String,
     #[serde(default = "default_spacing")]
     pub spacing_mm: f64,
@@ -205,7 +205,7 @@ impl Generator for Repost {
 /// spacing (mm).
 pub struct Planned {
     pub initial: std::collections::BTreeMap<metamodule::Meta, State>,
-    pub goal: std::collections::BTreeSet<metamodule::Meta>,
+    pub goal: std::collections::BTreeMap<metamodule::Meta, State>,
     pub plan: planner::Plan,
     pub spacing_mm: f64,
 }
@@ -216,22 +216,13 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
     let p: PlannerParams = parameters(scenario)?;
     let (ip, gp) = (scenario.resolve(&p.initial), scenario.resolve(&p.goal));
     let initial = shape::load(&ip)?;
-    let goal_states = shape::load(&gp)?;
-    // Filling goal meta-modules (compression) is not planned: refuse
-    // rather than build them SPARSE.
-    if let Some((m, _)) = goal_states.iter().find(|(_, st)| **st == State::Full) {
-        return Err(InputError::new(format!(
-            "goal meta-module {m} (leader cell {}) is FULL: the planner builds SPARSE goals only (filling destinations, for compression, are not implemented)",
-            m.leader()
-        ))
-        .in_file(&gp));
-    }
-    let goal: std::collections::BTreeSet<_> = goal_states.into_keys().collect();
+    let goal = shape::load(&gp)?;
     let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
         .expect("the FCC lattice has derived motion rules");
     let plan = planner::plan(&initial, &goal, rules).map_err(|e| {
         let file = match e {
             planner::PlanError::Bound { .. }
+            | planner::PlanError::Catoms { .. }
             | planner::PlanError::Unreachable(_)
             | planner::PlanError::Stuck(..) => &gp,
             planner::PlanError::NoCoordinator => &ip,

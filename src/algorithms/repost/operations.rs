@@ -169,13 +169,15 @@ pub fn derive(dir: Direction, fill: State) -> Result<OperationPlan, InputError> 
 /// then the highest source catom; a choice that leads to a state where
 /// no catom can reach any remaining target is undone. Only removable
 /// source catoms (the rest stays connected) move. The scene is updated;
-/// the paths are returned in execution order. On failure, the first goal
-/// cell of the order that stays unfilled.
+/// the paths are returned in execution order. The search expands at
+/// most `budget` states. On failure, the first goal cell of the order that
+/// stays unfilled.
 pub fn move_catoms(
     s: &mut Scene,
     sources: &[Cell],
     targets: &[Cell],
     strict: bool,
+    budget: usize,
 ) -> Result<Vec<Vec<Hop>>, Cell> {
     assert!(sources.len() <= 32 && targets.len() <= 32);
     let mut search = Dfs {
@@ -183,7 +185,7 @@ pub fn move_catoms(
         targets,
         strict,
         failed: FxHashSet::default(),
-        budget: SEARCH_BUDGET,
+        budget,
         paths: Vec::new(),
         best_depth: (0, 0),
     };
@@ -202,6 +204,13 @@ pub fn move_catoms(
 
 /// States the depth-first search of [`move_catoms`] may expand.
 pub const SEARCH_BUDGET: usize = 300;
+
+/// The budget for filling a meta-module's interior inside a structure
+/// (the planner's compression): its neighbours, FULL already, leave the
+/// interior cells fewer ways in, and 300 states do not find one (the
+/// 3 × 3 × 4 compression stops at its ninth meta-module with 300 and
+/// plans with 3,000).
+pub const FILL_SEARCH_BUDGET: usize = 3000;
 
 struct Dfs<'a> {
     sources: &'a [Cell],
@@ -283,7 +292,7 @@ fn plan(scene: &OperationScene, order: &[Cell], strict: bool) -> Result<Operatio
         .map(|m| m.1)
         .collect();
     let start = s.clone();
-    let paths = move_catoms(&mut s, &sources, &targets, strict).map_err(|cell| {
+    let paths = move_catoms(&mut s, &sources, &targets, strict, SEARCH_BUDGET).map_err(|cell| {
         InputError::new(format!(
             "RePoSt assemble-{} {}: no source catom can reach goal cell {cell}",
             match scene.fill {

@@ -8,11 +8,13 @@
 //!    meta-module in both shapes, the lowest), so that dismantling all of
 //!    them together leaves the rest connected; when that plan fails, only
 //!    the leaves nearest the far end of the structure (see [`plan`]). Every
-//!    FULL meta-module is a source too: its filling catoms leave, its
-//!    loop stays.
+//!    FULL meta-module the goal does not want FULL is a source too: its
+//!    filling catoms leave, its loop stays.
 //! 2. **Destinations**: SPARSE goal meta-modules next to an empty goal
 //!    cell; each empty goal cell goes to exactly one destination and each
-//!    destination serves one cell.
+//!    destination serves one cell. Then SPARSE meta-modules the goal
+//!    wants FULL (compression), lowest first: the catoms fill their
+//!    interior (recorded as the pair `(d, d)`).
 //! 3. **Streamlines**: maximum flow from sources to destinations with unit
 //!    capacities on the meta-modules (node splitting), by Dinic's
 //!    algorithm (`petgraph::algo::dinics`): streamlines are
@@ -28,7 +30,7 @@
 
 use super::messages::{self, IterationRecord, Messages};
 use super::metamodule::{Meta, State};
-use super::operations::move_catoms;
+use super::operations::{FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
 use super::pipeline::pipeline;
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
@@ -36,13 +38,15 @@ use crate::lattice::Cell;
 use crate::lattice::config::ModuleId;
 use petgraph::graph::{DiGraph, NodeIndex};
 use rustc_hash::{FxHashMap, FxHashSet};
-use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
 
 /// Why a goal cannot be planned, with the meta-module it is about.
 #[derive(Clone, Debug, PartialEq)]
 pub enum PlanError {
     /// The goal size is outside ⌈N/20⌉ ≤ S_G ≤ N/10.
     Bound { catoms: usize, goal: usize },
+    /// The goal's loops and fillings do not hold the initial catoms.
+    Catoms { initial: usize, goal: usize },
     /// No meta-module is in both shapes (no global coordinator).
     NoCoordinator,
     /// An empty goal cell that no streamline can reach.
@@ -59,6 +63,10 @@ impl std::fmt::Display for PlanError {
                 "goal of {goal} meta-modules is outside the bound ⌈N/20⌉ ≤ S_G ≤ N/10 for N = {catoms} catoms ({}..={})",
                 catoms.div_ceil(20),
                 catoms / 10
+            ),
+            PlanError::Catoms { initial, goal } => write!(
+                f,
+                "the goal's meta-modules hold {goal} catoms (10 per SPARSE, 20 per FULL), the initial shape {initial}: no reconfiguration ends on it"
             ),
             PlanError::NoCoordinator => write!(f, "no meta-module is in both shapes"),
             PlanError::Unreachable(m) => {
@@ -117,10 +125,10 @@ fn region(m: Meta) -> impl Iterator<Item = Cell> {
 }
 
 /// The global coordinator: the lowest meta-module in both shapes.
-fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeSet<Meta>) -> Option<Meta> {
+fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeMap<Meta, State>) -> Option<Meta> {
     initial
         .keys()
-        .filter(|m| goal.contains(m))
+        .filter(|m| goal.contains_key(m))
         .min_by_key(|m| (m.z, m.x, m.y))
         .copied()
 }
@@ -153,7 +161,8 @@ fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
         .map(move |d| m.step(d))
 }
 
-/// Plans the reconfiguration from `initial` to `goal` (meta-module states).
+/// Plans the reconfiguration from `initial` to `goal` (meta-module states:
+/// a FULL goal meta-module is filled, the paper's compression).
 ///
 /// Which leaves to dismantle first is the paper's free choice. Taking
 /// every leaf can wall a source in: a SPARSE meta-module on the ground
@@ -165,7 +174,7 @@ fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
 /// plans is kept (`Plan::source_width`).
 pub fn plan(
     initial: &BTreeMap<Meta, State>,
-    goal: &BTreeSet<Meta>,
+    goal: &BTreeMap<Meta, State>,
     rules: &dyn MotionRules,
 ) -> Result<Plan, PlanError> {
     let first = match plan_with(initial, goal, rules, None) {
@@ -189,18 +198,30 @@ pub fn plan(
 /// the deepest leaf (`None`: every leaf).
 fn plan_with(
     initial: &BTreeMap<Meta, State>,
-    goal: &BTreeSet<Meta>,
+    goal: &BTreeMap<Meta, State>,
     rules: &dyn MotionRules,
     width: Option<usize>,
 ) -> Result<Plan, PlanError> {
-    let catoms: usize = initial
-        .values()
-        .map(|s| if *s == State::Full { 20 } else { 10 })
-        .sum();
+    let held = |m: &BTreeMap<Meta, State>| -> usize {
+        m.values()
+            .map(|s| match s {
+                State::Full => 20,
+                State::Sparse => 10,
+                State::Empty => 0,
+            })
+            .sum()
+    };
+    let catoms = held(initial);
     if goal.len() < catoms.div_ceil(20) || goal.len() > catoms / 10 {
         return Err(PlanError::Bound {
             catoms,
             goal: goal.len(),
+        });
+    }
+    if held(goal) != catoms {
+        return Err(PlanError::Catoms {
+            initial: catoms,
+            goal: held(goal),
         });
     }
     let gc = coordinator(initial, goal).ok_or(PlanError::NoCoordinator)?;
@@ -222,21 +243,28 @@ fn plan_with(
     };
     loop {
         let empty: Vec<Meta> = goal
-            .iter()
+            .keys()
             .filter(|m| !state.contains_key(m))
             .copied()
             .collect();
         let extra: Vec<Meta> = state
             .keys()
-            .filter(|m| !goal.contains(m))
+            .filter(|m| !goal.contains_key(m))
             .copied()
             .collect();
+        // FULL meta-modules the goal wants SPARSE or gone give their
+        // filling; SPARSE ones the goal wants FULL are to be filled.
         let full: Vec<Meta> = state
             .iter()
-            .filter(|(_, st)| **st == State::Full)
+            .filter(|(m, st)| **st == State::Full && goal.get(m) != Some(&State::Full))
             .map(|(m, _)| *m)
             .collect();
-        if empty.is_empty() && extra.is_empty() && full.is_empty() {
+        let to_fill: Vec<Meta> = state
+            .iter()
+            .filter(|(m, st)| **st == State::Sparse && goal.get(m) == Some(&State::Full))
+            .map(|(m, _)| *m)
+            .collect();
+        if empty.is_empty() && extra.is_empty() && full.is_empty() && to_fill.is_empty() {
             return Ok(out);
         }
         // 1. Sources: leaves of the BFS tree from the coordinator outside
@@ -259,7 +287,7 @@ fn plan_with(
         // 2. Destinations: one per empty goal cell, lowest cells first.
         // Built bottom-up: a goal cell whose cell below is empty waits
         // (a meta-module would otherwise hang from its destination).
-        let low = goal.iter().map(|m| m.z).min().unwrap_or(0);
+        let low = goal.keys().map(|m| m.z).min().unwrap_or(0);
         let mut empty_sorted: Vec<Meta> = empty
             .iter()
             .filter(|m| {
@@ -275,10 +303,19 @@ fn plan_with(
         let mut destinations: Vec<(Meta, Meta)> = Vec::new();
         for e in &empty_sorted {
             if let Some(d) = adjacent(*e).find(|d| {
-                goal.contains(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
+                goal.contains_key(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
             }) {
                 taken.insert(d);
                 destinations.push((d, *e));
+            }
+        }
+        // Filling destinations (compression), lowest first: `(d, d)`, the
+        // catoms go into d's interior.
+        let mut to_fill = to_fill;
+        to_fill.sort_by_key(|m| (m.z, m.x, m.y));
+        for d in to_fill {
+            if taken.insert(d) {
+                destinations.push((d, d));
             }
         }
         // 3. Streamlines by max-flow with unit vertex capacities, and
@@ -301,7 +338,13 @@ fn plan_with(
                 .collect();
             let open_dest: Vec<(Meta, Meta)> = destinations
                 .iter()
-                .filter(|(_, e)| !state.contains_key(e))
+                .filter(|(d, e)| {
+                    if d == e {
+                        state.get(d) == Some(&State::Sparse)
+                    } else {
+                        !state.contains_key(e)
+                    }
+                })
                 .copied()
                 .collect();
             let lines = streamlines(&state, &open, &open_dest);
@@ -316,7 +359,8 @@ fn plan_with(
                     .find(|(d, _)| *d == dst)
                     .map(|(_, e)| *e)
                     .expect("a destination has its goal cell");
-                match transport(&scene, &line, state[&src], goal_meta) {
+                let fill = goal_meta == dst;
+                match transport(&scene, &line, state[&src], goal_meta, fill) {
                     Ok(paths) => {
                         // The next streamline plans against this one's end state.
                         for p in &paths {
@@ -330,7 +374,7 @@ fn plan_with(
                         } else {
                             state.remove(&src);
                         }
-                        state.insert(goal_meta, State::Sparse);
+                        state.insert(goal_meta, if fill { State::Full } else { State::Sparse });
                         planned.push(line);
                         progress = true;
                     }
@@ -403,8 +447,8 @@ fn plan_with(
     }
 }
 
-/// The paths of a streamline's ten catoms to the goal meta-module's loop,
-/// planned against `scene`: inside the streamline's meta-module boxes
+/// The paths of a streamline's ten catoms to the goal meta-module's loop
+/// (its interior, if `fill`), planned against `scene`: inside the streamline's meta-module boxes
 /// first, then with one cell of margin, then anywhere in the structure's
 /// box grown by three cells (the ground cells of a goal beside the
 /// structure may be reachable only around it); strictly (no sliding
@@ -414,6 +458,7 @@ fn transport(
     line: &[Meta],
     source: State,
     goal_meta: Meta,
+    fill: bool,
 ) -> Result<Vec<Vec<Hop>>, Cell> {
     // A FULL source gives its ten filling catoms; a SPARSE one its loop.
     let from = if source == State::Full {
@@ -421,7 +466,26 @@ fn transport(
     } else {
         line[0].sparse_cells()
     };
-    let targets = goal_meta.sparse_cells();
+    let targets = if fill {
+        goal_meta.filling_cells()
+    } else {
+        goal_meta.sparse_cells()
+    };
+    // The loop in its own order (each catom latches the one before); an
+    // interior in the orders the operations were derived with.
+    let orders: Vec<Vec<Cell>> = if fill {
+        super::operations::orders(&targets)
+            .into_iter()
+            .map(|(_, o)| o)
+            .collect()
+    } else {
+        vec![targets.to_vec()]
+    };
+    let budget = if fill {
+        FILL_SEARCH_BUDGET
+    } else {
+        SEARCH_BUDGET
+    };
     let mut last = targets[0];
     for margin in [Some(0), Some(1), None] {
         let mut s = scene.clone();
@@ -442,9 +506,11 @@ fn transport(
             None => s.fit_box(&targets, 3),
         }
         for strict in [true, false] {
-            match move_catoms(&mut s.clone(), &from, &targets, strict) {
-                Ok(p) => return Ok(p),
-                Err(c) => last = c,
+            for order in &orders {
+                match move_catoms(&mut s.clone(), &from, order, strict, budget) {
+                    Ok(p) => return Ok(p),
+                    Err(c) => last = c,
+                }
             }
         }
     }
