@@ -183,6 +183,25 @@ fn a_goal_outside_the_compression_bound_exits_2_naming_the_bound() {
     assert!(err.contains("three.txt") && err.contains("N/10"), "{err}");
 }
 
+/// Generates the bundled scenario `scenarios/{name}.toml`.
+fn generate_bundled(name: &str) -> reconfcheck::schedule::Schedule {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sc = reconfcheck::scenario::Scenario::load(&root.join(format!("scenarios/{name}.toml")))
+        .unwrap();
+    reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Certifies `s` with its model removed (lattice checks and the exact
+/// sweeps of every concurrent pair) and asserts that it passes, the
+/// collision check included.
+fn certifies_collision_free(s: &reconfcheck::schedule::Schedule) {
+    let mut geometry_only = s.clone();
+    geometry_only.model = None;
+    let r = certify(&geometry_only, &Options::default()).unwrap();
+    assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
+    assert!(r.certified, "{}", r.summary());
+}
+
 /// Replays the schedule's rotations and asserts that the catoms end
 /// exactly on the goal shape `file` (`models/shapes/repost/`): the loops
 /// of its meta-modules, and the interiors of its FULL ones.
@@ -220,10 +239,7 @@ fn ends_on_the_goal(s: &reconfcheck::schedule::Schedule, file: &str) {
 /// docs/repost.md, far too long for the suite).
 #[test]
 fn the_l_to_c_planner_completes_and_its_schedule_is_collision_free() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let sc =
-        reconfcheck::scenario::Scenario::load(&root.join("scenarios/repost-l-to-c.toml")).unwrap();
-    let s = reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"));
+    let s = generate_bundled("repost-l-to-c");
     let iterations = s.meta["iterations"].as_u64().unwrap();
     assert!((7..=20).contains(&iterations), "{iterations} iterations");
     assert!(
@@ -248,11 +264,7 @@ fn the_l_to_c_planner_completes_and_its_schedule_is_collision_free() {
     assert!(s.steps.iter().any(|st| st.events.len() >= 10));
     // Concurrent movers are exactly what the certifier checks pairwise
     // with the exact body.
-    let mut geometry_only = s.clone();
-    geometry_only.model = None;
-    let r = certify(&geometry_only, &Options::default()).unwrap();
-    assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
-    assert!(r.certified, "{}", r.summary());
+    certifies_collision_free(&s);
 }
 
 /// Two catoms rolling along a row on the ground, the second planned
@@ -503,11 +515,7 @@ fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
 /// sweeps of every concurrent pair).
 #[test]
 fn the_expansion_empties_every_full_meta_module_into_a_new_top_layer_in_one_iteration() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let sc =
-        reconfcheck::scenario::Scenario::load(&root.join("scenarios/repost-expand-6x6x3.toml"))
-            .unwrap();
-    let s = reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"));
+    let s = generate_bundled("repost-expand-6x6x3");
     assert_eq!(s.modules.len(), 1440);
     assert_eq!(s.meta["iterations"].as_u64(), Some(1));
     let it = &s.meta["iteration_detail"][0];
@@ -517,10 +525,7 @@ fn the_expansion_empties_every_full_meta_module_into_a_new_top_layer_in_one_iter
     // are streamlines.
     assert!(s.steps.iter().any(|st| st.events.len() > 36));
     ends_on_the_goal(&s, "block-6x6x4.txt");
-    let mut geometry_only = s.clone();
-    geometry_only.model = None;
-    let r = certify(&geometry_only, &Options::default()).unwrap();
-    assert!(r.certified, "{}", r.summary());
+    certifies_collision_free(&s);
 }
 
 /// A goal whose loops and fillings do not hold exactly the initial catoms
@@ -551,11 +556,7 @@ fn a_goal_that_holds_a_different_number_of_catoms_is_refused_naming_the_goal_fil
 /// pair).
 #[test]
 fn compression_fills_the_bottom_meta_modules_with_the_top_layer() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let sc =
-        reconfcheck::scenario::Scenario::load(&root.join("scenarios/repost-compress-2x2x4.toml"))
-            .unwrap();
-    let s = reconfcheck::algorithms::generate(&sc).unwrap_or_else(|e| panic!("{e}"));
+    let s = generate_bundled("repost-compress-2x2x4");
     assert_eq!(s.modules.len(), 160);
     let its = s.meta["iteration_detail"].as_array().unwrap();
     let mut filled = Vec::new();
@@ -571,8 +572,5 @@ fn compression_fills_the_bottom_meta_modules_with_the_top_layer() {
     }
     assert_eq!(filled.len(), 4, "each bottom meta-module filled once");
     ends_on_the_goal(&s, "block-2x2x3-full-bottom.txt");
-    let mut geometry_only = s.clone();
-    geometry_only.model = None;
-    let r = certify(&geometry_only, &Options::default()).unwrap();
-    assert!(r.certified, "{}", r.summary());
+    certifies_collision_free(&s);
 }
