@@ -208,7 +208,7 @@ pub const SEARCH_BUDGET: usize = 300;
 /// The budget for filling a meta-module's interior inside a structure
 /// (the planner's compression): its neighbours, FULL already, leave the
 /// interior cells fewer ways in, and 300 states do not find one (the
-/// 3 × 3 × 4 compression stops at its ninth meta-module with 300 and
+/// 3 × 3 × 4 compression stops at its eighth meta-module with 300 and
 /// plans with 3,000).
 pub const FILL_SEARCH_BUDGET: usize = 3000;
 
