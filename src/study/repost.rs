@@ -16,7 +16,7 @@
 
 use super::fit::{LinearFit, linear_fit};
 use crate::algorithms::repost::messages::Messages;
-use crate::algorithms::repost::metamodule::{Direction, Meta};
+use crate::algorithms::repost::metamodule::Meta;
 use crate::algorithms::repost::{plan_scenario, planner::Plan};
 use crate::error::InputError;
 use crate::scenario::Scenario;
@@ -115,8 +115,7 @@ pub fn diameter(metas: &std::collections::BTreeSet<Meta>) -> usize {
         while let Some(m) = queue.pop_front() {
             let d = seen[&m];
             best = best.max(d);
-            for dir in Direction::ALL {
-                let n = m.step(dir);
+            for n in m.adjacent() {
                 if metas.contains(&n) && !seen.contains_key(&n) {
                     seen.insert(n, d + 1);
                     queue.push_back(n);
@@ -143,14 +142,7 @@ pub fn fig10(scenarios: &[Scenario], progress: &dyn Fn(&str)) -> Result<Fig10, I
             iterations: p.plan.iterations.len(),
             steps: p.plan.steps.len(),
             rotations: p.plan.steps.iter().map(Vec::len).sum(),
-            messages: p
-                .plan
-                .iterations
-                .iter()
-                .fold(Messages::default(), |mut a, it| {
-                    a += it.messages;
-                    a
-                }),
+            messages: p.plan.iterations.iter().map(|it| it.messages).sum(),
         });
     }
     let pts = |f: &dyn Fn(&SizeRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();

@@ -38,7 +38,7 @@
 //! the start of each phase cost nothing: the authors' code reads them from
 //! global maps.
 
-use super::metamodule::{Direction, Meta, State};
+use super::metamodule::{Meta, SpanningTree, State};
 use super::search::Hop;
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, FccLattice, Lattice};
@@ -60,6 +60,15 @@ impl Messages {
     }
 }
 
+impl std::iter::Sum for Messages {
+    fn sum<I: Iterator<Item = Messages>>(it: I) -> Messages {
+        it.fold(Messages::default(), |mut a, m| {
+            a += m;
+            a
+        })
+    }
+}
+
 impl std::ops::AddAssign for Messages {
     fn add_assign(&mut self, o: Messages) {
         self.tree += o.tree;
@@ -73,8 +82,9 @@ impl std::ops::AddAssign for Messages {
 pub struct IterationRecord<'a> {
     /// The meta-modules at the start of the iteration.
     pub present: &'a BTreeMap<Meta, State>,
-    /// The global coordinator (root of the tree).
-    pub coordinator: Meta,
+    /// The spanning tree the coordinator's Go flood builds over
+    /// `present`: the planner's own.
+    pub tree: &'a SpanningTree,
     pub sources: &'a [Meta],
     /// In the order the flow found them.
     pub streamlines: &'a [Vec<Meta>],
@@ -117,10 +127,6 @@ fn meta_hops(cells: &FxHashMap<Cell, ModuleId>, a: Meta, b: Meta) -> usize {
         .unwrap_or(1)
 }
 
-fn neighbours(m: Meta) -> impl Iterator<Item = Meta> {
-    Direction::ALL.into_iter().map(move |d| m.step(d))
-}
-
 /// Counts an iteration's messages.
 pub fn count(it: &IterationRecord) -> Messages {
     let mut memo: FxHashMap<(Meta, Meta), usize> = FxHashMap::default();
@@ -131,20 +137,10 @@ pub fn count(it: &IterationRecord) -> Messages {
             .or_insert_with(|| meta_hops(it.cells, key.0, key.1))
     };
     let present = |m: &Meta| it.present.contains_key(m);
-    // The Go flood's tree (breadth first from the coordinator).
-    let mut parent: BTreeMap<Meta, Option<Meta>> = BTreeMap::from([(it.coordinator, None)]);
-    let mut queue = VecDeque::from([it.coordinator]);
-    while let Some(m) = queue.pop_front() {
-        for n in neighbours(m).filter(present) {
-            if let std::collections::btree_map::Entry::Vacant(e) = parent.entry(n) {
-                e.insert(Some(m));
-                queue.push_back(n);
-            }
-        }
-    }
     let mut out = Messages::default();
-    for (&m, &p) in &parent {
-        for n in neighbours(m).filter(present) {
+    for &m in it.tree.depth.keys() {
+        let p = it.tree.parent.get(&m).copied();
+        for n in m.adjacent().filter(present) {
             if Some(n) != p {
                 out.tree += 2 * route(m, n); // Go, and its Back
             }
@@ -168,7 +164,7 @@ pub fn count(it: &IterationRecord) -> Messages {
         let mut queue: VecDeque<Meta> = open.iter().copied().collect();
         let mut logical = 0;
         while let Some(m) = queue.pop_front() {
-            for n in neighbours(m).filter(present) {
+            for n in m.adjacent().filter(present) {
                 logical += route(m, n); // BFS to every neighbour
                 if free(&n) && !reached.contains_key(&n) {
                     reached.insert(n, Some(m));
@@ -270,6 +266,7 @@ fn transport(it: &IterationRecord) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algorithms::repost::metamodule::{Direction, spanning_tree};
 
     fn sparse(metas: &[Meta]) -> FxHashMap<Cell, ModuleId> {
         let mut at = FxHashMap::default();
@@ -328,7 +325,7 @@ mod tests {
         let cells = sparse(&[s, m, d]);
         let got = count(&IterationRecord {
             present: &present,
-            coordinator: d,
+            tree: &spanning_tree(|m| present.contains_key(m), d),
             sources: &[s],
             streamlines: &[vec![s, m, d]],
             cells: &cells,
@@ -369,7 +366,7 @@ mod tests {
         let present = BTreeMap::new();
         let it = IterationRecord {
             present: &present,
-            coordinator: Meta::new(0, 0, 0),
+            tree: &spanning_tree(|_| false, Meta::new(0, 0, 0)),
             sources: &[],
             streamlines: &[],
             cells: &cells,

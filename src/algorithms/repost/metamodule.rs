@@ -33,6 +33,44 @@ impl Meta {
     pub fn direction_to(self, other: Meta) -> Option<Direction> {
         Direction::ALL.into_iter().find(|d| self.step(*d) == other)
     }
+
+    /// The six face neighbours, in [`Direction::ALL`] order.
+    pub fn adjacent(self) -> impl Iterator<Item = Meta> {
+        Direction::ALL.into_iter().map(move |d| self.step(d))
+    }
+}
+
+/// The breadth-first spanning tree of the meta-modules `present` from
+/// `root` (neighbours in [`Meta::adjacent`] order): the planner's
+/// connectivity tree, whose leaves may be dismantled, and the tree the
+/// protocol's Go flood builds.
+pub struct SpanningTree {
+    /// Each reached meta-module's level (the root's is 0).
+    pub depth: rustc_hash::FxHashMap<Meta, usize>,
+    /// Each reached meta-module but the root → its parent.
+    pub parent: rustc_hash::FxHashMap<Meta, Meta>,
+    /// How many children each has (leaves have none, and no entry).
+    pub children: rustc_hash::FxHashMap<Meta, usize>,
+}
+
+pub fn spanning_tree(present: impl Fn(&Meta) -> bool, root: Meta) -> SpanningTree {
+    let mut t = SpanningTree {
+        depth: rustc_hash::FxHashMap::from_iter([(root, 0)]),
+        parent: rustc_hash::FxHashMap::default(),
+        children: rustc_hash::FxHashMap::default(),
+    };
+    let mut queue = std::collections::VecDeque::from([root]);
+    while let Some(m) = queue.pop_front() {
+        for n in m.adjacent() {
+            if present(&n) && !t.depth.contains_key(&n) {
+                t.depth.insert(n, t.depth[&m] + 1);
+                t.parent.insert(n, m);
+                *t.children.entry(m).or_default() += 1;
+                queue.push_back(n);
+            }
+        }
+    }
+    t
 }
 
 impl std::fmt::Display for Meta {

@@ -29,7 +29,7 @@
 //!    the pipeline.
 
 use super::messages::{self, IterationRecord, Messages};
-use super::metamodule::{Meta, State};
+use super::metamodule::{Meta, State, spanning_tree};
 use super::operations::{FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
 use super::pipeline::pipeline;
 use super::search::{Hop, Scene};
@@ -38,7 +38,7 @@ use crate::lattice::Cell;
 use crate::lattice::config::ModuleId;
 use petgraph::graph::{DiGraph, NodeIndex};
 use rustc_hash::{FxHashMap, FxHashSet};
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::BTreeMap;
 
 /// Why a goal cannot be planned, with the meta-module it is about.
 #[derive(Clone, Debug, PartialEq)]
@@ -133,34 +133,6 @@ fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeMap<Meta, State>) ->
         .copied()
 }
 
-/// The breadth-first spanning tree of the meta-modules `present` from
-/// `root`: each reached one's level, and how many children each has
-/// (leaves have none).
-fn spanning_tree(
-    present: impl Fn(&Meta) -> bool,
-    root: Meta,
-) -> (FxHashMap<Meta, usize>, FxHashMap<Meta, usize>) {
-    let mut depth = FxHashMap::from_iter([(root, 0)]);
-    let mut children: FxHashMap<Meta, usize> = FxHashMap::default();
-    let mut queue = VecDeque::from([root]);
-    while let Some(m) = queue.pop_front() {
-        for n in adjacent(m) {
-            if present(&n) && !depth.contains_key(&n) {
-                depth.insert(n, depth[&m] + 1);
-                *children.entry(m).or_default() += 1;
-                queue.push_back(n);
-            }
-        }
-    }
-    (depth, children)
-}
-
-fn adjacent(m: Meta) -> impl Iterator<Item = Meta> {
-    super::metamodule::Direction::ALL
-        .into_iter()
-        .map(move |d| m.step(d))
-}
-
 /// Plans the reconfiguration from `initial` to `goal` (meta-module states:
 /// a FULL goal meta-module is filled, the paper's compression).
 ///
@@ -183,8 +155,8 @@ pub fn plan(
         Err(e) => e,
     };
     let deepest = coordinator(initial, goal).map_or(0, |gc| {
-        let (depth, _) = spanning_tree(|m| initial.contains_key(m), gc);
-        depth.into_values().max().unwrap_or(0)
+        let tree = spanning_tree(|m| initial.contains_key(m), gc);
+        tree.depth.into_values().max().unwrap_or(0)
     });
     for w in (0..deepest).rev() {
         if let Ok(p) = plan_with(initial, goal, rules, Some(w)) {
@@ -268,9 +240,10 @@ fn plan_with(
             return Ok(out);
         }
         // 1. Sources: leaves of the BFS tree from the coordinator outside
-        // the goal, and every FULL meta-module (emptied to SPARSE, its
-        // loop stays: nothing disconnects).
-        let (depth, children) = spanning_tree(|m| state.contains_key(m), gc);
+        // the goal, and every FULL meta-module the goal does not want FULL
+        // (emptied to SPARSE, its loop stays: nothing disconnects).
+        let tree = spanning_tree(|m| state.contains_key(m), gc);
+        let (depth, children) = (&tree.depth, &tree.children);
         let mut sources: Vec<Meta> = extra
             .iter()
             .filter(|m| children.get(m).copied().unwrap_or(0) == 0 && state[m] == State::Sparse)
@@ -302,7 +275,7 @@ fn plan_with(
         let mut taken: FxHashSet<Meta> = FxHashSet::default();
         let mut destinations: Vec<(Meta, Meta)> = Vec::new();
         for e in &empty_sorted {
-            if let Some(d) = adjacent(*e).find(|d| {
+            if let Some(d) = e.adjacent().find(|d| {
                 goal.contains_key(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
             }) {
                 taken.insert(d);
@@ -409,8 +382,9 @@ fn plan_with(
                 true
             }
             None => {
-                // No pipeline (a catom that fits nowhere): run the streamlines one after another, the
-                // order they were planned in (valid by construction).
+                // No pipeline (a catom that fits nowhere): run the
+                // streamlines one after another, the order they were
+                // planned in (valid by construction).
                 for lane in lanes {
                     let steps: Vec<Vec<Hop>> =
                         lane.into_iter().flatten().map(|h| vec![h]).collect();
@@ -422,7 +396,7 @@ fn plan_with(
         };
         let messages = messages::count(&IterationRecord {
             present: &present,
-            coordinator: gc,
+            tree: &tree,
             sources: &sources,
             streamlines: &streamlines,
             cells: &before.at,
@@ -448,8 +422,9 @@ fn plan_with(
 }
 
 /// The paths of a streamline's ten catoms to the goal meta-module's loop
-/// (its interior, if `fill`), planned against `scene`: inside the streamline's meta-module boxes
-/// first, then with one cell of margin, then anywhere in the structure's
+/// (its interior, if `fill`), planned against `scene`: inside the
+/// streamline's meta-module boxes first, then with one cell of margin,
+/// then anywhere in the structure's
 /// box grown by three cells (the ground cells of a goal beside the
 /// structure may be reachable only around it); strictly (no sliding
 /// contact) first in each. On failure, the first goal cell left unfilled.
@@ -539,7 +514,7 @@ fn streamlines(
         io.insert(*m, (i, o));
     }
     for (m, (_, o)) in &io {
-        for n in adjacent(*m) {
+        for n in m.adjacent() {
             if state.get(&n) == Some(&State::Full) {
                 continue;
             }
