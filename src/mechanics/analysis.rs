@@ -156,7 +156,8 @@ struct Judged {
 #[derive(Copy, Clone, Debug)]
 struct LimitOutcome {
     /// With connectors rigid, the smallest factor over the failing poses:
-    /// below 1, the component tips or slides there.
+    /// below 1, the component tips or slides there (∞, not solved, when
+    /// the capacities' factor shows that every pose holds).
     rigid: f64,
     /// With every link within capacity, the smallest factor over the poses
     /// analysed (the worst of all failing poses, see [`Analyzer::limit`]):
@@ -398,8 +399,8 @@ struct Reference {
 /// step that factored it, and CG preconditioned by it, started from the
 /// previous displacements of the same bodies, solves the current step —
 /// exactly in one iteration when only the loads changed. It is tried only
-/// while at most [`Settings::reuse_max_changed`] bodies changed, for at
-/// most [`Settings::reuse_iterations`] iterations; otherwise the component
+/// while at most `Settings::reuse_max_changed` bodies changed, for at
+/// most `Settings::reuse_iterations` iterations; otherwise the component
 /// is factored afresh and that factor is kept.
 pub struct Analyzer {
     pub model: Model,
@@ -481,7 +482,7 @@ impl Analyzer {
     /// Analyses one structure.
     ///
     /// Per connected component of free bodies:
-    /// 1. **Elastic screen** ([`Analyzer::screen`]): the elastic network at
+    /// 1. **Elastic screen** (`Analyzer::screen`): the elastic network at
     ///    a reference pose (each mover at its largest horizontal lever),
     ///    ground contacts made unilateral by an active set; then, with that
     ///    active set, every sampled pose of the movers' rotations (common
@@ -489,7 +490,7 @@ impl Analyzer {
     ///    within capacity at a pose, that elastic solution is an admissible
     ///    equilibrium: by the lower-bound theorem the component stands
     ///    there, and its utilisations are reported.
-    /// 2. **Limit analysis** ([`super::limit`]) at every pose the screen
+    /// 2. **Limit analysis** (the `limit` module) at every pose the screen
     ///    could not clear: with connectors rigid (does the component stand
     ///    on its supports at all?) and within capacities (the load factor
     ///    `λ`). "No static equilibrium" comes only from here, or from a
@@ -965,14 +966,6 @@ impl Analyzer {
             bodies: &comps.bodies[c],
             links: &comps.links[c],
         };
-        // A NaN (solver failure) sticks: it reads as overloaded everywhere.
-        for &(pose, _) in failing {
-            let loads = body_loads(s, pose);
-            let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
-            // (Held by a fixed module, the rigid case needs no solve.)
-            out.runs += usize::from(rigid.iterations > 0);
-            out.rigid = lowest(out.rigid, rigid.lambda);
-        }
         // The poses' problems are independent: past the first (a failing
         // step usually fails there), they are solved in waves of as many
         // as there are threads, ahead of the sequential logic below, which
@@ -1048,6 +1041,23 @@ impl Analyzer {
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
+        }
+        // With rigid connectors the feasible forces include every one
+        // within capacities (the support rows are the same, and summing
+        // the bodies' balances cancels the internal links), so the rigid
+        // factor is at least the capacities' one. When every pose holds
+        // (solved, spared or bounded by the smallest, all ≥ 1), the
+        // component stands and no rigid solve is needed; only a failing
+        // component is asked whether it tips or slides, at every pose.
+        // A NaN (solver failure) sticks: it reads as overloaded everywhere.
+        if out.capacities.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) || out.partial {
+            for &(pose, _) in failing {
+                let loads = body_loads(s, pose);
+                let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
+                // (Held by a fixed module, the rigid case needs no solve.)
+                out.runs += usize::from(rigid.iterations > 0);
+                out.rigid = lowest(out.rigid, rigid.lambda);
+            }
         }
         out
     }

@@ -3,16 +3,16 @@
 //! runs it per step, and the branch-length study (`crate::study`) over many
 //! schedules.
 //!
-//! * [`model`] — the physical model (TOML in `models/`): mass, connector
+//! * `model` — the physical model (TOML in `models/`): mass, connector
 //!   capacity, ground contact;
-//! * [`capacity`] — connector failure criteria and utilisation;
-//! * [`structure`] — a configuration as rigid bodies, connector links and
+//! * `capacity` — connector failure criteria and utilisation;
+//! * `structure` — a configuration as rigid bodies, connector links and
 //!   movers hanging on their pivots, from any [`crate::lattice::Lattice`];
-//! * [`analysis`] — the static solve (elastic interface network, unilateral
+//! * `analysis` — the static solve (elastic interface network, unilateral
 //!   ground by active set) with reuse between consecutive steps;
-//! * [`solver`], [`direct`] — preconditioned CG over 6 × 6 blocks and the
+//! * `solver`, `direct` — preconditioned CG over 6 × 6 blocks and the
 //!   sparse Cholesky factor (faer) that preconditions it;
-//! * [`closed_form`] — the cantilever bounds the study is checked against.
+//! * `closed_form` — the cantilever bounds the study is checked against.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
