@@ -44,9 +44,9 @@ fn default_geometric() -> bool {
 
 /// The geometric move filter: a candidate rotation is taken when none of
 /// the cells its sweep penetrates or touches (derived motion rules,
-/// [`MotionRules::touched_cells`]) is occupied at the start of the step or
+/// [`crate::geometry::MotionRules::touched_cells`]) is occupied at the start of the step or
 /// claimed as a target by a move already chosen, and when its sweep keeps
-/// clear of every chosen move's sweep ([`MotionRules::concurrent_clear`]).
+/// clear of every chosen move's sweep ([`crate::geometry::MotionRules::concurrent_clear`]).
 /// Walks generated with it certify without collisions or sliding contacts.
 pub fn collision_free(config: &Configuration, m: &Motion, chosen: &[Motion]) -> bool {
     let rules = crate::geometry::motion_rules(LatticeKind::Fcc)

@@ -62,7 +62,7 @@ impl LoadCheck {
 
     /// This check with the limit analysis's factor reported within
     /// `tolerance` of the exact one (see
-    /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`]);
+    /// `Settings::load_factor_tolerance` in the mechanics);
     /// 0 is exact.
     pub fn with_load_factor_tolerance(mut self, tolerance: f64) -> LoadCheck {
         self.load_factor_tolerance = tolerance;

@@ -58,7 +58,7 @@ pub struct Options {
     pub range_done: Option<fn(&RangeDone)>,
     /// How far above the exact smallest load factor of a step's poses the
     /// reported one may lie, as a fraction of it (0: exact; see
-    /// [`crate::mechanics::analysis::Settings::load_factor_tolerance`]).
+    /// `Settings::load_factor_tolerance` in the mechanics).
     pub load_factor_tolerance: f64,
 }
 

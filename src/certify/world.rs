@@ -193,7 +193,8 @@ impl World {
 
     /// The modules not connected to the ground or a fixed module, with
     /// `exclude` taken out of the structure. When the scene is known to be
-    /// anchored (see [`World::set_anchored`]) only the neighbours of the
+    /// anchored (see [`World::check_anchored`] and
+    /// [`World::confirm_anchored`]) only the neighbours of the
     /// lifted modules can have lost their anchor, and the search stays local
     /// to them ([`Configuration::unanchored_near`]): a step then costs in
     /// proportion to the movers' surroundings, not to the whole structure.

@@ -8,8 +8,8 @@
 //! flush on it; the floor is what the RePoSt operations roll over.
 //!
 //! The lowest point of the mover at `s` is `−h(s, −ẑ)`, with `h` the
-//! mover's support function ([`Roll::support`]). It is `V`-Lipschitz in
-//! `s` (`V` = [`Roll::speed_bound`]: every point of the inner polyhedron
+//! mover's support function (`Roll::support`). It is `V`-Lipschitz in
+//! `s` (`V` = `Roll::speed_bound`: every point of the inner polyhedron
 //! moves at most `V·Δs`, and the rounding adds a constant), so its minimum
 //! over the sweep is bracketed by Piyavskii's branch and bound: an interval
 //! `[a, b]` holds nothing below `(f(a) + f(b) − V·(b − a))/2`. The bracket
@@ -110,7 +110,7 @@ const MAX_EVALUATIONS: usize = 1 << 20;
 /// to within `bracket`.
 ///
 /// A half that turns about a vertical axis keeps the mover's extent along
-/// `z` constant (see [`Roll::half_axis`]), so its value at either end is
+/// `z` constant (see `Roll::half_axis`), so its value at either end is
 /// its minimum; bracketing it by Lipschitz bounds would never close. The
 /// other halves go through the branch and bound.
 pub fn lowest_point(roll: &Roll, bracket: f64) -> LowestPoint {

@@ -45,7 +45,7 @@ pub struct Row {
     pub min_pressure_elastic: f64,
     /// Closed form: root utilisation of the branch family's worst step,
     /// `b − 1` modules and an agent beyond the base (see
-    /// [`closed_branch_max`]), and the pressures it needs.
+    /// `closed_branch_max`), and the pressures it needs.
     pub closed_utilisation: f64,
     pub closed_pressure_rigid_hinge: f64,
     pub closed_pressure_elastic: f64,
@@ -98,7 +98,7 @@ pub struct Study {
     pub unplanned: Vec<Unplanned>,
     /// Largest studied `b` such that every `b' ≤ b` is safe (0 if none).
     pub b_max: usize,
-    /// Closed-form largest `b` of the branch family ([`closed_branch_max`]).
+    /// Closed-form largest `b` of the branch family (`closed_branch_max`).
     pub closed_b_max: usize,
     pub sweep: Vec<SweepRow>,
 }

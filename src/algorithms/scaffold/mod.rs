@@ -8,7 +8,8 @@
 //! * [`paper`] — the paper's own motion constraint and light protocol;
 //! * [`feed`] — when modules leave the sandbox (just in time, or eagerly
 //!   as the authors' implementation feeds them);
-//! * [`plot`] — modules-placed-per-step curves (seed 000 Fig. 13–16).
+//! * the modules-placed-per-step curves (seed 000 Figs. 13–16) are drawn
+//!   in [`crate::study::scaffold_figures`], not here.
 //!
 //! See `docs/scaffold.md`.
 
