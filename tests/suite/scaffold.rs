@@ -419,19 +419,71 @@ fn an_eager_feed_is_faster_in_both_protocols_and_its_safe_schedules_certify_clea
             .len()
     };
     let eager: Vec<usize> = (2..=4)
-        .map(|h| steps(h, Protocol::Paper, Feed::Eager))
+        .map(|h| steps(h, Protocol::Paper, Feed::EAGER))
         .collect();
     assert_eq!(eager, [59, 124, 190]);
     for (h, &t) in (2..=4u32).zip(&eager) {
         assert!(t < steps(h, Protocol::Paper, Feed::JustInTime), "h = {h}");
     }
     let shape = ShapeSpec::Pyramid { h: 3 };
-    let s = scaffold_schedule_fed(&shape, 6, Protocol::Safe, Feed::Eager).unwrap();
+    let s = scaffold_schedule_fed(&shape, 6, Protocol::Safe, Feed::EAGER).unwrap();
     assert_eq!(s.meta["feed"], "eager");
     assert!(s.steps.len() < scaffold_schedule(&shape, 6).unwrap().steps.len());
     let r = certify(&s, &Options::default()).unwrap();
     assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
     assert!(r.certified && r.warnings.is_empty(), "{}", r.summary());
+}
+
+/// `eager_window` spans the readings between the two feeds: no window is
+/// just in time (h = 3: 146 steps), a window of 2 steps already takes
+/// most of the gain (133), and the default does not bind (124). The
+/// window reaches the schedule's meta, and a window without the eager
+/// feed, or beyond the limit, is refused naming the parameter.
+#[test]
+fn an_eager_window_spans_the_readings_from_just_in_time_to_eager() {
+    use reconfcheck::algorithms::scaffold::feed::EAGER_WINDOW;
+    let dir = common::scratch_dir("scaffold-eager-window");
+    let scenario = |name: &str, extra: &str| {
+        let p = dir.join(format!("{name}.toml"));
+        std::fs::write(
+            &p,
+            format!(
+                "name = \"{name}\"\nalgorithm = \"scaffold\"\n[parameters]\nshape = \"pyramid\"\n\
+                 h = 3\nprotocol = \"paper\"\n{extra}"
+            ),
+        )
+        .unwrap();
+        let sc = reconfcheck::scenario::Scenario::load(&p).unwrap();
+        (p, reconfcheck::algorithms::generate(&sc))
+    };
+    let steps = |name: &str, extra: &str| {
+        let s = scenario(name, extra).1.unwrap();
+        (s.steps.len(), s.meta.get("eager_window").cloned())
+    };
+    let (jit, none) = steps("jit", "");
+    assert_eq!((jit, none), (146, None));
+    assert_eq!(steps("w0", "feed = \"eager\"\neager_window = 0").0, jit);
+    let (two, w) = steps("w2", "feed = \"eager\"\neager_window = 2");
+    assert_eq!((two, w), (133, Some(2.into())));
+    let (eager, w) = steps("eager", "feed = \"eager\"");
+    assert_eq!((eager, w), (124, Some(EAGER_WINDOW.into())));
+    for (name, extra, says) in [
+        ("jit-window", "eager_window = 2", "only with feed"),
+        (
+            "too-wide",
+            "feed = \"eager\"\neager_window = 5000",
+            "at most",
+        ),
+    ] {
+        let (p, r) = scenario(name, extra);
+        let e = r.unwrap_err();
+        assert!(
+            e.message.contains("parameter eager_window") && e.message.contains(says),
+            "{}",
+            e.message
+        );
+        assert_eq!(e.file.as_deref(), Some(p.as_path()));
+    }
 }
 
 /// A wall on a plate: the plate's upward branches under the wall's inner

@@ -13,8 +13,11 @@
 //!   tile root inserts a module into each incident branch whose entry
 //!   point's light pivot is green, as long as that branch's requirement is
 //!   not met. Modules travel ahead of need and wait in the structure. The
-//!   planner lets a module leave up to [`EAGER_WINDOW`] steps before its
-//!   just-in-time departure when that makes it arrive sooner.
+//!   planner lets a module leave up to a window of steps before its
+//!   just-in-time departure when that makes it arrive sooner: by default
+//!   [`EAGER_WINDOW`], which does not bind; the scenario's `eager_window`
+//!   narrows it, to study the readings between the two (0 is just in time
+//!   except where traffic delays a departure).
 
 /// How far ahead of its just-in-time departure an eager module may leave
 /// (steps). Measured: 40 and 100 give the same step counts on pyramid
@@ -30,17 +33,23 @@ pub enum Feed {
     /// Leave so as to arrive when the component becomes buildable.
     #[default]
     JustInTime,
-    /// Leave as early as the path allows (within [`EAGER_WINDOW`]), as the
-    /// authors' sandbox feeds its entry points.
-    Eager,
+    /// Leave as early as the path allows, at most `window` steps before
+    /// the just-in-time departure, as the authors' sandbox feeds its entry
+    /// points.
+    Eager { window: usize },
 }
 
 impl Feed {
+    /// The authors' feeding, with the window that does not bind.
+    pub const EAGER: Feed = Feed::Eager {
+        window: EAGER_WINDOW,
+    };
+
     /// Parses a scenario's `feed` parameter.
     pub fn parse(s: &str) -> Option<Feed> {
         match s {
             "just-in-time" => Some(Feed::JustInTime),
-            "eager" => Some(Feed::Eager),
+            "eager" => Some(Feed::EAGER),
             _ => None,
         }
     }
@@ -48,7 +57,7 @@ impl Feed {
     pub fn name(self) -> &'static str {
         match self {
             Feed::JustInTime => "just-in-time",
-            Feed::Eager => "eager",
+            Feed::Eager { .. } => "eager",
         }
     }
 }

@@ -313,6 +313,9 @@ pub fn schedule_for(
     sched.meta.insert("b".into(), s.b.into());
     sched.meta.insert("protocol".into(), protocol.name().into());
     sched.meta.insert("feed".into(), feed.name().into());
+    if let Feed::Eager { window } = feed {
+        sched.meta.insert("eager_window".into(), window.into());
+    }
     sched.meta.insert("tiles".into(), s.tiles.len().into());
     // Seed 000's Eq. 6 times the critical path: the step at which the
     // first tile root of each tile layer is in place (1-based steps).
@@ -375,7 +378,16 @@ struct Params {
     /// "just-in-time" (default) or "eager" (see [`feed::Feed`]).
     #[serde(default)]
     feed: Option<String>,
+    /// With `feed = "eager"`: how many steps before its just-in-time
+    /// departure a module may leave (default [`feed::EAGER_WINDOW`]).
+    #[serde(default)]
+    eager_window: Option<u32>,
 }
+
+/// The widest `eager_window` a scenario may ask for: each step of window
+/// is one more departure tried per module (the sandcastle takes 86 s to
+/// generate at 100), and from 40 on the window no longer binds.
+const MAX_EAGER_WINDOW: u32 = 1000;
 
 fn default_b() -> u32 {
     6
@@ -452,6 +464,22 @@ impl Generator for ScaffoldAssembly {
             Feed::parse,
             "just-in-time, eager",
         )?;
+        let feed = match (feed, p.eager_window) {
+            (_, None) => feed,
+            (Feed::Eager { .. }, Some(w)) if w <= MAX_EAGER_WINDOW => {
+                Feed::Eager { window: w as usize }
+            }
+            (Feed::Eager { .. }, Some(w)) => {
+                return Err(scenario.error(format!(
+                    "parameter eager_window is {w}: at most {MAX_EAGER_WINDOW} steps"
+                )));
+            }
+            (Feed::JustInTime, Some(_)) => {
+                return Err(scenario.error(
+                    "parameter eager_window applies only with feed = \"eager\"".to_string(),
+                ));
+            }
+        };
         scaffold_schedule_fed(&spec, p.b, protocol, feed).map_err(|e| e.in_file(&scenario.path))
     }
 }

@@ -27,7 +27,7 @@
 //! between free agents beyond that (an earlier version kept free agents
 //! out of neighbouring cells, 13–25 % slower, see docs/scaffold.md).
 
-use super::feed::{EAGER_WINDOW, Feed};
+use super::feed::Feed;
 use super::paper::Protocol;
 use super::scaffold::Scaffold;
 use super::shape::Skew;
@@ -442,12 +442,12 @@ impl<'a> Planner<'a> {
             }
             t0 += 1;
         };
-        if self.feed == Feed::Eager {
+        if let Feed::Eager { window } = self.feed {
             // Leave earlier while that arrives sooner (later departures
             // first: among equal arrivals the module holds cells least).
             let soonest = (ready + 1).max(hops.len() + 1);
             let mut arrival = *steps.last().unwrap_or(&t0);
-            let earliest = (ready + 1).saturating_sub(hops.len() + EAGER_WINDOW).max(1);
+            let earliest = (ready + 1).saturating_sub(hops.len() + window).max(1);
             for e in (earliest..t0).rev() {
                 if arrival == soonest {
                     break;
