@@ -184,6 +184,11 @@ fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
     if let Some(lf) = a.load_factor.filter(|x| x.is_finite()) {
         out.metrics.insert("load_factor".into(), lf);
     }
+    // With a tolerance, what is proven of the exact factor: it lies
+    // between this and `load_factor`.
+    if let Some(lower) = a.load_factor_lower.filter(|x| x.is_finite()) {
+        out.metrics.insert("load_factor_lower_bound".into(), lower);
+    }
     // Where the limit analysis judged, its load factor says by how much.
     let at_most = if a.load_factor_partial {
         "at most "

@@ -309,7 +309,7 @@ impl Report {
         if self.load_factor_tolerance > 0.0 {
             let _ = writeln!(
                 s,
-                "load factors: each exact one is at least (1 − {}) × the reported one (--load-factor-tolerance); verdicts exact",
+                "load factors: each exact one is at least (1 − {}) × the reported one and at least its load_factor_lower_bound (--load-factor-tolerance); verdicts exact",
                 self.load_factor_tolerance
             );
         }
@@ -362,7 +362,7 @@ impl Report {
         }
         // Each metric's worst step: the highest, but for a load factor the
         // lowest (the step nearest to collapse).
-        let lowest_is_worst = |k: &str| k == "load_factor";
+        let lowest_is_worst = |k: &str| k.starts_with("load_factor");
         let mut metrics: BTreeMap<&str, (f64, usize)> = BTreeMap::new();
         for r in &self.per_step {
             for (k, &v) in &r.metrics {

@@ -399,7 +399,7 @@
   // ---- Per-step maxima -----------------------------------------------------
   if (D.metrics.length) {
     const s = section('Per-step maxima', 'metrics');
-    const lowest = k => k === 'load_factor';
+    const lowest = k => k.startsWith('load_factor');
     const rows = D.metrics.map(([k, vals]) => {
       let best = null, at = 0;
       vals.forEach((v, i) => { if (v !== null && (best === null || (lowest(k) ? v < best : v > best))) { best = v; at = i + 1; } });

@@ -92,6 +92,12 @@ pub struct Analysis {
     /// bound on its factor was left unanalysed: the true smallest factor
     /// may be lower than `load_factor` (the verdict stands).
     pub load_factor_partial: bool,
+    /// With a load-factor tolerance: a proven lower bound of the exact
+    /// smallest factor (the smallest of the factors solved and of the
+    /// bounds that spared the other poses), so the exact one lies in
+    /// `[load_factor_lower, load_factor]`; 0 where a pose was left out
+    /// with no bound. `None` when exact or when no limit analysis ran.
+    pub load_factor_lower: Option<f64>,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
     pub critical: Option<Critical>,
@@ -169,6 +175,9 @@ struct LimitOutcome {
     /// Some failing pose was left unanalysed, with no bound: `capacities`
     /// is the smallest found, an upper bound of the true smallest.
     partial: bool,
+    /// A proven lower bound of the smallest factor over the poses (see
+    /// [`Analysis::load_factor_lower`]).
+    lower: f64,
 }
 
 /// Solver settings.
@@ -961,6 +970,7 @@ impl Analyzer {
             admissible: 0.0,
             runs: 0,
             partial: false,
+            lower: f64::INFINITY,
         };
         let part = limit::Part {
             bodies: &comps.bodies[c],
@@ -990,12 +1000,15 @@ impl Analyzer {
                 // only the smallest found (`partial`).
                 if bound.is_finite() {
                     out.capacities = lowest(out.capacities, 1.0 / bound);
+                    out.lower = lowest(out.lower, 1.0 / bound);
                 } else {
                     out.partial = true;
+                    out.lower = 0.0;
                 }
                 continue;
             }
-            if self.spared_by(s, part, &fields, pose, out.capacities) {
+            if let Some(b) = self.spared_by(s, part, &fields, pose, out.capacities) {
+                out.lower = lowest(out.lower, b);
                 continue;
             }
             if solved[i].is_none() {
@@ -1008,8 +1021,10 @@ impl Analyzer {
                     if ahead.len() >= wave {
                         break;
                     }
-                    let known =
-                        solved[j].is_some() || self.spared_by(s, part, &fields, p, out.capacities);
+                    let known = solved[j].is_some()
+                        || self
+                            .spared_by(s, part, &fields, p, out.capacities)
+                            .is_some();
                     if !known {
                         ahead.push(j);
                     }
@@ -1040,6 +1055,7 @@ impl Analyzer {
             }
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
+            out.lower = lowest(out.lower, cap.lambda);
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
         // With rigid connectors the feasible forces include every one
@@ -1062,9 +1078,10 @@ impl Analyzer {
         out
     }
 
-    /// Whether the fields solved so far prove that `pose` holds within the
-    /// tolerance of `smallest` ([`spared`]); never when exact or before a
-    /// field is known (no bound is built then).
+    /// The bound by which the fields solved so far prove that `pose`
+    /// holds within the tolerance of `smallest` ([`spared`]), if they do;
+    /// never when exact or before a field is known (no bound is built
+    /// then).
     fn spared_by(
         &self,
         s: &Structure,
@@ -1072,11 +1089,13 @@ impl Analyzer {
         fields: &[(Option<usize>, limit::Field)],
         pose: Option<usize>,
         smallest: f64,
-    ) -> bool {
+    ) -> Option<f64> {
         let tolerance = self.settings.load_factor_tolerance;
-        tolerance > 0.0
-            && !fields.is_empty()
-            && spared(self.pose_bound(s, part, fields, pose), smallest, tolerance)
+        if tolerance <= 0.0 || fields.is_empty() {
+            return None;
+        }
+        let bound = self.pose_bound(s, part, fields, pose);
+        spared(bound, smallest, tolerance).then_some(bound)
     }
 
     /// A lower bound of the load factor at `pose` from the equilibrium of
@@ -1197,6 +1216,11 @@ impl Analyzer {
             let lf = l.capacities;
             out.load_factor = Some(out.load_factor.map_or(lf, |x| lowest(x, lf)));
             out.load_factor_partial |= l.partial;
+            if self.settings.load_factor_tolerance > 0.0 {
+                let lower = lowest(l.lower, l.capacities);
+                out.load_factor_lower =
+                    Some(out.load_factor_lower.map_or(lower, |x| lowest(x, lower)));
+            }
             if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.

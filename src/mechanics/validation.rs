@@ -664,10 +664,18 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
                 skipping * (1.0 - tau) <= lambda * (1.0 + 1e-9),
                 "{skipping} vs {lambda}"
             );
+            // The proven lower bound brackets the exact factor from below,
+            // no looser than the tolerance; an exact run reports none.
+            let lower = spared.load_factor_lower.expect("a lower bound with τ");
+            assert!(lower <= lambda * (1.0 + 1e-9), "{lower} > {lambda}");
+            assert!(lower >= skipping * (1.0 - tau) * (1.0 - 1e-9), "{lower}");
+            assert!(lower < skipping, "some pose was spared: {lower}");
+            assert_eq!(exact.load_factor_lower, None);
             // Waves of poses solved ahead on idle threads change nothing.
             let t = on(3, &s, tau);
             assert_eq!(t.load_factor.map(f64::to_bits), Some(skipping.to_bits()));
             assert_eq!(t.limit_analyses, spared.limit_analyses);
+            assert_eq!(t.load_factor_lower.map(f64::to_bits), Some(lower.to_bits()));
             let e = on(3, &s, 0.0);
             assert_eq!(e.load_factor.map(f64::to_bits), Some(lambda.to_bits()));
         }
