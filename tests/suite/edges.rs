@@ -364,3 +364,67 @@ fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts(
         );
     }
 }
+
+/// A run with a load-factor tolerance reports, at every step the limit
+/// analysis judged, a proven lower bound of the exact factor beside the
+/// reported one; an exact run reports none. The structure: a cantilever
+/// two modules deep from one fixed root, seven long, with a module
+/// swinging on its upper tip — it holds only plastically, at every pose.
+#[test]
+fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() {
+    use reconfcheck::certify::{Options, certify};
+    use reconfcheck::lattice::{Cell, LatticeKind};
+    use reconfcheck::schedule::{Length, ModuleSpec, Schedule};
+    let n = 7;
+    let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+    let mut id = 0;
+    for z in 0..2 {
+        for x in 0..=n {
+            s.modules.push(ModuleSpec {
+                id,
+                cell: Cell::new(x, 0, z),
+                fixed: id == 0,
+            });
+            id += 1;
+        }
+    }
+    s.modules.push(ModuleSpec {
+        id,
+        cell: Cell::new(n + 1, 0, 1),
+        fixed: false,
+    });
+    let pivot = 2 * n as u32 + 1;
+    common::step(
+        &mut s,
+        vec![common::rot(
+            id,
+            pivot,
+            Cell::new(n + 1, 0, 1),
+            Cell::new(n, 1, 1),
+        )],
+    );
+    let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let run = |tolerance: f64| {
+        let opts = Options {
+            model: Some(model.clone()),
+            load_factor_tolerance: tolerance,
+            ..Default::default()
+        };
+        certify(&s, &opts).expect("usable input")
+    };
+    let exact = run(0.0);
+    let spared = run(0.05);
+    let metric = |r: &reconfcheck::certify::Report, k: &str| r.per_step[0].metrics.get(k).copied();
+    let lambda = metric(&exact, "load_factor").expect("judged by the limit analysis");
+    assert_eq!(metric(&exact, "load_factor_lower_bound"), None);
+    let reported = metric(&spared, "load_factor").unwrap();
+    let lower = metric(&spared, "load_factor_lower_bound").expect("a lower bound with τ");
+    assert!(lower <= lambda * (1.0 + 1e-9) && lambda <= reported * (1.0 + 1e-9));
+    assert!(
+        lower >= 0.95 * reported * (1.0 - 1e-9),
+        "{lower} vs {reported}"
+    );
+    assert!(spared.summary().contains("lowest load_factor_lower_bound"));
+    assert!(exact.certified && spared.certified, "{}", exact.summary());
+    assert!(lambda > 1.0, "{lambda}");
+}
