@@ -1066,7 +1066,8 @@ impl Analyzer {
         // component stands and no rigid solve is needed; only a failing
         // component is asked whether it tips or slides, at every pose.
         // A NaN (solver failure) sticks: it reads as overloaded everywhere.
-        if out.capacities.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) || out.partial {
+        // (A pose left out, `partial`, comes only after a failing one.)
+        if out.capacities.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
             for &(pose, _) in failing {
                 let loads = body_loads(s, pose);
                 let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);

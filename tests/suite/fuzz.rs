@@ -288,10 +288,6 @@ proptest! {
             Err(_) => prop_assert!(false, "panicked on {edited:?}"),
         }
     }
-}
-
-proptest! {
-    #![proptest_config(config(256))]
 
     /// The meta-module shape files of seed 001: an edited FULL-bottom
     /// block is refused naming the file, or loads to meta-modules on the
