@@ -302,6 +302,109 @@ pub fn replay(
     Ok(())
 }
 
+/// [`replay`] split into ranges of `range` consecutive steps (0: one range)
+/// that run in parallel on this process's threads, each from the scene a
+/// first cheap pass recorded at its start and with its own analyser (the
+/// reuse between steps restarts at each range, as in certification), with
+/// the limit analysis's `load_factor_tolerance`. `visit` sees every step
+/// (1-based; `steps + 1` is the final configuration) and returns what the
+/// caller keeps of it; the results come back in step order. Range
+/// boundaries depend on `range` alone, so the results are the same on any
+/// number of threads. `tick` is called once per step analysed.
+pub fn replay_ranged<T: Send>(
+    schedule: &crate::schedule::Schedule,
+    model: &Model,
+    load_factor_tolerance: f64,
+    range: usize,
+    visit: impl Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync,
+    tick: impl Fn() + Sync,
+) -> Result<Vec<T>, crate::error::InputError> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let model = model.at_spacing_checked(schedule.spacing.metres())?;
+    let fresh = || {
+        LoadCheck::at_spacing(model.clone(), true).with_load_factor_tolerance(load_factor_tolerance)
+    };
+    let n = schedule.steps.len();
+    let range = if range == 0 { n.max(1) } else { range };
+    // The cheap pass: the scene at each range's start, and the final one.
+    let mut world = World::initial(schedule)?;
+    let mut starts = Vec::new();
+    for k in 0..n {
+        if k % range == 0 {
+            starts.push((k, world.clone()));
+        }
+        let (_, _, clashes) = super::advance(&mut world, schedule, k, |_| ())?;
+        if let Some(clash) = clashes.first() {
+            return Err(crate::error::InputError::new(format!(
+                "step {}: {}",
+                k + 1,
+                clash.message
+            )));
+        }
+    }
+    // Job 0 is the final configuration (the largest structure), then the
+    // ranges last first: structures grow, so the costliest go out first.
+    let jobs = starts.len() + 1;
+    let slots: Vec<Mutex<Vec<T>>> = (0..jobs).map(|_| Mutex::new(Vec::new())).collect();
+    let handed = AtomicUsize::new(0);
+    let first_error: Mutex<Option<(usize, crate::error::InputError)>> = Mutex::new(None);
+    let run = |job: usize| -> Result<Vec<T>, crate::error::InputError> {
+        let check = fresh();
+        if job == 0 {
+            let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
+            tick();
+            return Ok(vec![visit(n + 1, &s, &a, &StepOutcome::default())]);
+        }
+        let (first, start) = &starts[job - 1];
+        let mut w = start.clone();
+        let mut found = Vec::new();
+        for k in *first..(first + range).min(n) {
+            let (seen, _, _) = super::advance(&mut w, schedule, k, |ctx| {
+                let mut out = StepOutcome::of_plan(ctx.plan);
+                super::LatticeCheck.check(ctx, &mut out);
+                let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
+                let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
+                visit(k + 1, &s, &a, &out)
+            })?;
+            tick();
+            found.push(seen);
+        }
+        Ok(found)
+    };
+    let threads = rayon::current_num_threads().max(1);
+    rayon::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|_| {
+                loop {
+                    let k = handed.fetch_add(1, Ordering::Relaxed);
+                    if k >= jobs {
+                        break;
+                    }
+                    let job = if k == 0 { 0 } else { jobs - k };
+                    match run(job) {
+                        Ok(found) => *slots[job].lock().expect("slot") = found,
+                        Err(e) => {
+                            let mut first = first_error.lock().expect("error slot");
+                            if first.as_ref().is_none_or(|(j, _)| job < *j) {
+                                *first = Some((job, e));
+                            }
+                        }
+                    }
+                }
+            });
+        }
+    });
+    if let Some((_, e)) = first_error.into_inner().expect("error slot") {
+        return Err(e);
+    }
+    let mut slots: Vec<Vec<T>> = slots
+        .into_iter()
+        .map(|m| m.into_inner().expect("slot"))
+        .collect();
+    let last = slots.remove(0);
+    Ok(slots.into_iter().flatten().chain(last).collect())
+}
+
 /// The structure and its analysis at each of `steps` (1-based; `steps + 1`
 /// of the schedule is the final configuration), in one replay that solves
 /// only those steps: what a viewer needs to show a few load maps of a long
@@ -477,6 +580,60 @@ mod tests {
         };
         assert_eq!(key(&one), key(&ranged));
         assert!(key(&one).iter().any(|&(_, k)| k == ViolationKind::Overload));
+    }
+
+    #[test]
+    fn a_replay_in_ranges_matches_the_one_pass_and_does_not_depend_on_the_threads() {
+        // The overloaded 2-pyramid at b = 9: elastic steps and failing
+        // ones (limit analyses), in ranges of 7 steps that restart the
+        // analyser's reuse.
+        let s = crate::algorithms::scaffold::scaffold_schedule(
+            &crate::algorithms::scaffold::ShapeSpec::Pyramid { h: 2 },
+            9,
+        )
+        .unwrap();
+        let m = Model::default_catom();
+        let key = |a: &Analysis| (a.max_utilisation, a.verdict(), a.load_factor);
+        let mut one = Vec::new();
+        replay(&s, &m, true, |k, _, a, _| one.push((k, key(a)))).unwrap();
+        let ranged = |threads: usize| {
+            let ticks = std::sync::atomic::AtomicUsize::new(0);
+            let found = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    replay_ranged(
+                        &s,
+                        &m,
+                        0.0,
+                        7,
+                        |k, _, a, _| (k, key(a)),
+                        || {
+                            ticks.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        },
+                    )
+                })
+                .unwrap();
+            assert_eq!(ticks.into_inner(), found.len());
+            found
+        };
+        let (r1, r3) = (ranged(1), ranged(3));
+        assert_eq!(format!("{r1:?}"), format!("{r3:?}"));
+        assert_eq!(r1.len(), s.steps.len() + 1);
+        assert!(r1.iter().any(|(_, (_, v, _))| *v == Verdict::Overloaded));
+        for ((k, (u, v, l)), (k1, (u1, v1, l1))) in r1.iter().zip(&one) {
+            assert_eq!(k, k1);
+            assert_eq!(v, v1, "step {k}");
+            assert!(
+                (u - u1).abs() <= 1e-9 * u1.abs().max(1.0),
+                "step {k}: {u} vs {u1}"
+            );
+            assert_eq!(l.is_some(), l1.is_some(), "step {k}");
+            if let (Some(l), Some(l1)) = (l, l1) {
+                assert!((l - l1).abs() <= 1e-6 * l1, "step {k}: {l} vs {l1}");
+            }
+        }
     }
 
     #[test]

@@ -19,7 +19,7 @@ pub use collision_check::CollisionCheck;
 pub use docking_check::DockingCheck;
 pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
-pub use load_check::{LoadCheck, load_maps_at, replay};
+pub use load_check::{LoadCheck, load_maps_at, replay, replay_ranged};
 pub use report::{Report, Severity, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 
@@ -181,10 +181,18 @@ const RANGES: usize = 64;
 /// report the same bytes on 1 thread or 16. Short schedules (under 64
 /// steps) run in one pass.
 fn range_steps(opts: &Options, steps: usize) -> usize {
-    match opts.range_steps {
-        Some(n) => n,
-        None if steps < 64 => 0,
-        None => steps.div_ceil(RANGES).max(16),
+    opts.range_steps
+        .unwrap_or_else(|| default_range_steps(steps))
+}
+
+/// The default steps per range (`Options::range_steps`) for a schedule of
+/// `steps` steps (0: one pass), for other replays split the same way (the
+/// b-study's).
+pub fn default_range_steps(steps: usize) -> usize {
+    if steps < 64 {
+        0
+    } else {
+        steps.div_ceil(RANGES).max(16)
     }
 }
 

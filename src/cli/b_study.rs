@@ -48,6 +48,11 @@ pub struct Args {
     /// Write the study as a self-contained HTML page (curves and table).
     #[arg(long, value_name = "REPORT.html")]
     html: Option<PathBuf>,
+    /// As `certify --load-factor-tolerance`: a failing structure's
+    /// limit-analysis factor may read up to this fraction of itself high, in
+    /// [0, 0.5); which b are safe stays exact. 0 is exact.
+    #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
+    load_factor_tolerance: f64,
 }
 
 /// `--pressure` in kPa as the model's pressure in Pa: positive and finite
@@ -60,6 +65,7 @@ fn pressure_pa(kpa: f64) -> Result<f64, InputError> {
 }
 
 pub fn run(a: Args) -> Result<u8, Error> {
+    let tolerance = super::report::load_factor_tolerance(a.load_factor_tolerance)?;
     let mut m = Model::load(&a.model)?;
     if a.pressure.is_some() || a.bending.is_some() {
         let pressure = match a.pressure {
@@ -85,7 +91,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         .into_iter()
         .map(|i| lengths[i])
         .collect();
-    let part = b_study::study_rows(&m, &mine, &generate, &progress);
+    let part = b_study::study_rows(&m, &mine, &generate, &progress, tolerance);
     let (rows, unplanned, first_error) = match part {
         Ok((rows, unplanned, first)) => (Ok(rows), Ok(unplanned), first),
         Err(e) => (Err(e.clone()), Err(e), None),
@@ -105,7 +111,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             })
             .into());
     }
-    let st = b_study::assemble(&a.family, &m, rows, unplanned);
+    let st = b_study::assemble(&a.family, &m, rows, unplanned, tolerance);
     print!("{}", st.table());
     #[cfg(feature = "render")]
     if let Some(p) = &a.plot {

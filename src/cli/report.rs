@@ -73,13 +73,7 @@ impl ReportArgs {
     pub fn options(&self, origin: &Path) -> Result<Options, Error> {
         let epsilon =
             Tolerance::new(self.epsilon).map_err(|e| InputError::new(format!("--epsilon: {e}")))?;
-        let t = self.load_factor_tolerance;
-        if !(0.0..0.5).contains(&t) {
-            return Err(InputError::new(format!(
-                "--load-factor-tolerance: {t} is not a fraction in [0, 0.5)"
-            ))
-            .into());
-        }
+        let t = load_factor_tolerance(self.load_factor_tolerance)?;
         Ok(Options {
             name: origin.display().to_string(),
             progress: super::progress::reporter(
@@ -97,6 +91,18 @@ impl ReportArgs {
                 .then_some(print_range_time),
             load_factor_tolerance: t,
         })
+    }
+}
+
+/// `--load-factor-tolerance`, checked: a fraction in [0, 0.5) (NaN is
+/// refused, not read as exact).
+pub fn load_factor_tolerance(t: f64) -> Result<f64, InputError> {
+    if (0.0..0.5).contains(&t) {
+        Ok(t)
+    } else {
+        Err(InputError::new(format!(
+            "--load-factor-tolerance: {t} is not a fraction in [0, 0.5)"
+        )))
     }
 }
 

@@ -459,8 +459,12 @@ proptest! {
                         prop_assert!((x - y).abs() <= tol, "image {}: {} vs {}", k, x, y);
                     }
                 }
+                // Each factor is an interior-point solve that may stop at
+                // its loosest accepted gap (1e-6, `limit::maximise`), so two
+                // solves of mirrored programs differ by a few of those
+                // (52.67116 against 52.67123 on a regression case).
                 (Some(x), Some(y)) => prop_assert!(
-                    (x - y).abs() <= 1e-6 * x.abs().max(1.0),
+                    (x - y).abs() <= 1e-5 * x.abs().max(1.0),
                     "image {}: λ {} vs {}", k, x, y
                 ),
                 (x, y) => prop_assert!(false, "image {}: λ {:?} vs {:?}", k, x, y),

@@ -10,13 +10,15 @@
 //! bending criteria, and `b_max(p)` for any `p` follows without
 //! re-solving.
 
-use crate::certify::load_check::replay;
+use crate::certify::StepOutcome;
+use crate::certify::load_check::replay_ranged;
 use crate::certify::report::ViolationKind;
 use crate::error::InputError;
-use crate::mechanics::analysis::{Critical, Verdict};
+use crate::mechanics::analysis::{Analysis, Critical, Verdict};
 use crate::mechanics::capacity::required_pressure;
 use crate::mechanics::closed_form;
-use crate::mechanics::model::{Bending, Model};
+use crate::mechanics::model::{Bending, Capacity, Model};
+use crate::mechanics::structure::Structure;
 use crate::progress::Reporter;
 use crate::schedule::Schedule;
 use serde::Serialize;
@@ -49,6 +51,10 @@ pub struct Row {
     pub closed_utilisation: f64,
     pub closed_pressure_rigid_hinge: f64,
     pub closed_pressure_elastic: f64,
+    /// Limit analyses (LP/SOCP solves) the replay took: where the time
+    /// went (a load-factor tolerance spares some).
+    #[serde(default)]
+    pub limit_analyses: usize,
 }
 
 impl Row {
@@ -101,6 +107,10 @@ pub struct Study {
     /// Closed-form largest `b` of the branch family (`closed_branch_max`).
     pub closed_b_max: usize,
     pub sweep: Vec<SweepRow>,
+    /// The limit analysis's load-factor tolerance the rows were found with
+    /// (0: exact). Which b are safe does not depend on it; a failing
+    /// structure's utilisation `1/λ` may read up to this fraction low.
+    pub load_factor_tolerance: f64,
 }
 
 /// The closed form in the branch family's terms: growing a branch of `b`
@@ -227,11 +237,72 @@ pub fn b_study(
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
 ) -> Result<Study, InputError> {
-    let (rows, unplanned, first_error) = study_rows(model, lengths, generate, progress)?;
+    let (rows, unplanned, first_error) = study_rows(model, lengths, generate, progress, 0.0)?;
     if let (true, Some(e)) = (rows.is_empty(), first_error) {
         return Err(e);
     }
-    Ok(assemble(family, model, rows, unplanned))
+    Ok(assemble(family, model, rows, unplanned, 0.0))
+}
+
+/// What the study keeps of one step's analysis.
+struct StepFinding {
+    step: usize,
+    lattice_violations: usize,
+    no_equilibrium: bool,
+    partial: bool,
+    max_utilisation: f64,
+    /// The critical element, described (only where it could be the row's).
+    critical: String,
+    min_pressure_rigid_hinge: f64,
+    min_pressure_elastic: f64,
+    limit_analyses: usize,
+}
+
+impl StepFinding {
+    fn of(
+        step: usize,
+        s: &Structure,
+        a: &Analysis,
+        out: &StepOutcome,
+        hinge: &Capacity,
+        elastic: &Capacity,
+    ) -> StepFinding {
+        let critical = match a.critical {
+            Some(Critical::Link(i)) => s.describe(&s.links[i]),
+            Some(Critical::Pivot(i)) => {
+                let h = &s.hanging[a.pivots[i].hanging];
+                format!("pivot connector {}–{}", h.mover, s.bodies[h.pivot].module)
+            }
+            None => String::new(),
+        };
+        let loads = s
+            .links
+            .iter()
+            .zip(&a.links)
+            .filter(|(l, r)| !l.is_ground() && !r.released)
+            .map(|(_, r)| r.load)
+            .chain(a.pivots.iter().map(|p| p.load));
+        let (mut rh, mut el) = (0.0f64, 0.0f64);
+        for load in loads {
+            rh = rh.max(required_pressure(&load, hinge));
+            el = el.max(required_pressure(&load, elastic));
+        }
+        StepFinding {
+            step,
+            lattice_violations: out
+                .violations
+                .iter()
+                .filter(|v| !matches!(v.kind, ViolationKind::Overload | ViolationKind::Unstable))
+                .count(),
+            no_equilibrium: a.verdict() == Verdict::NoEquilibrium,
+            partial: a.load_factor_partial,
+            max_utilisation: a.max_utilisation,
+            critical,
+            min_pressure_rigid_hinge: rh,
+            min_pressure_elastic: el,
+            limit_analyses: a.limit_analyses,
+        }
+    }
 }
 
 /// The rows of the b values in `lengths`, each from checking every step of
@@ -243,6 +314,7 @@ pub fn study_rows(
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
+    load_factor_tolerance: f64,
 ) -> Result<StudyRows, InputError> {
     let mut rows = Vec::new();
     let mut unplanned = Vec::new();
@@ -284,6 +356,7 @@ pub fn study_rows(
                 b.saturating_sub(1),
                 true,
             ),
+            limit_analyses: 0,
         };
         let hinge = crate::mechanics::model::Capacity {
             bending: Bending::RigidHinge,
@@ -293,45 +366,32 @@ pub fn study_rows(
             bending: Bending::Elastic,
             ..m.connector
         };
-        replay(&schedule, &m, true, |step, s, a, out| {
-            bar.advance(1);
-            row.lattice_violations += out
-                .violations
-                .iter()
-                .filter(|v| !matches!(v.kind, ViolationKind::Overload | ViolationKind::Unstable))
-                .count();
-            if a.verdict() == Verdict::NoEquilibrium {
-                row.no_equilibrium = true;
+        // Ranges of steps run in parallel (as in certification), each
+        // step's findings folded in step order: the row is the same on any
+        // number of threads.
+        let range = crate::certify::default_range_steps(schedule.steps.len());
+        let findings = replay_ranged(
+            &schedule,
+            &m,
+            load_factor_tolerance,
+            range,
+            |step, s, a, out| StepFinding::of(step, s, a, out, &hinge, &elastic),
+            || bar.advance(1),
+        )?;
+        for f in findings {
+            row.lattice_violations += f.lattice_violations;
+            row.limit_analyses += f.limit_analyses;
+            row.no_equilibrium |= f.no_equilibrium;
+            row.max_utilisation_at_least |= f.partial;
+            if f.max_utilisation > row.max_utilisation {
+                row.max_utilisation = f.max_utilisation;
+                row.critical_step = f.step;
+                row.critical_connector = f.critical;
             }
-            row.max_utilisation_at_least |= a.load_factor_partial;
-            if a.max_utilisation > row.max_utilisation {
-                row.max_utilisation = a.max_utilisation;
-                row.critical_step = step;
-                row.critical_connector = match a.critical {
-                    Some(Critical::Link(i)) => s.describe(&s.links[i]),
-                    Some(Critical::Pivot(i)) => {
-                        let h = &s.hanging[a.pivots[i].hanging];
-                        format!("pivot connector {}–{}", h.mover, s.bodies[h.pivot].module)
-                    }
-                    None => String::new(),
-                };
-            }
-            let loads = s
-                .links
-                .iter()
-                .zip(&a.links)
-                .filter(|(l, r)| !l.is_ground() && !r.released)
-                .map(|(_, r)| r.load)
-                .chain(a.pivots.iter().map(|p| p.load));
-            for load in loads {
-                row.min_pressure_rigid_hinge = row
-                    .min_pressure_rigid_hinge
-                    .max(required_pressure(&load, &hinge));
-                row.min_pressure_elastic = row
-                    .min_pressure_elastic
-                    .max(required_pressure(&load, &elastic));
-            }
-        })?;
+            row.min_pressure_rigid_hinge =
+                row.min_pressure_rigid_hinge.max(f.min_pressure_rigid_hinge);
+            row.min_pressure_elastic = row.min_pressure_elastic.max(f.min_pressure_elastic);
+        }
         bar.finish();
         if row.no_equilibrium {
             row.min_pressure_rigid_hinge = f64::INFINITY;
@@ -349,6 +409,7 @@ pub fn assemble(
     model: &Model,
     mut rows: Vec<Row>,
     mut unplanned: Vec<Unplanned>,
+    load_factor_tolerance: f64,
 ) -> Study {
     rows.sort_by_key(|r| r.b);
     unplanned.sort_by_key(|u| u.b);
@@ -393,6 +454,7 @@ pub fn assemble(
         b_max,
         closed_b_max: closed_branch_max(model),
         sweep,
+        load_factor_tolerance,
     }
 }
 
@@ -423,6 +485,13 @@ impl Study {
             self.pressure_kpa,
             self.bending.name()
         );
+        if self.load_factor_tolerance > 0.0 {
+            let _ = writeln!(
+                s,
+                "load-factor tolerance {}: safe b exact; a failing structure's max util may read up to that fraction low",
+                self.load_factor_tolerance
+            );
+        }
         let _ = writeln!(
             s,
             "{:>4} {:>6} {:>9} {:>9} {:>6} {:>10} {:>10} {:>10} {:>10}  critical",
@@ -564,13 +633,13 @@ mod tests {
             st.replayed_b(),
             Some((7, "the smallest b that does not hold"))
         );
-        let holding = assemble("branch", &model, st.rows[..5].to_vec(), Vec::new());
+        let holding = assemble("branch", &model, st.rows[..5].to_vec(), Vec::new(), 0.0);
         assert_eq!(
             holding.replayed_b(),
             Some((5, "the largest b studied; every b holds"))
         );
         assert_eq!(
-            assemble("branch", &model, Vec::new(), Vec::new()).replayed_b(),
+            assemble("branch", &model, Vec::new(), Vec::new(), 0.0).replayed_b(),
             None
         );
         // The summary's closed form counts the same weights as the family's

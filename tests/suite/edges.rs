@@ -365,14 +365,10 @@ fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts(
     }
 }
 
-/// A run with a load-factor tolerance reports, at every step the limit
-/// analysis judged, a proven lower bound of the exact factor beside the
-/// reported one; an exact run reports none. The structure: a cantilever
-/// two modules deep from one fixed root, seven long, with a module
-/// swinging on its upper tip — it holds only plastically, at every pose.
-#[test]
-fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() {
-    use reconfcheck::certify::{Options, certify};
+/// A cantilever two modules deep from one fixed root, seven long, with a
+/// module swinging on its upper tip: it holds only plastically, at every
+/// pose (one step).
+fn plastic_cantilever() -> reconfcheck::schedule::Schedule {
     use reconfcheck::lattice::{Cell, LatticeKind};
     use reconfcheck::schedule::{Length, ModuleSpec, Schedule};
     let n = 7;
@@ -403,6 +399,16 @@ fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() 
             Cell::new(n, 1, 1),
         )],
     );
+    s
+}
+
+/// A run with a load-factor tolerance reports, at every step the limit
+/// analysis judged, a proven lower bound of the exact factor beside the
+/// reported one; an exact run reports none (on [`plastic_cantilever`]).
+#[test]
+fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() {
+    use reconfcheck::certify::{Options, certify};
+    let s = plastic_cantilever();
     let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
     let run = |tolerance: f64| {
         let opts = Options {
@@ -427,4 +433,75 @@ fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() 
     assert!(spared.summary().contains("lowest load_factor_lower_bound"));
     assert!(exact.certified && spared.certified, "{}", exact.summary());
     assert!(lambda > 1.0, "{lambda}");
+}
+
+/// The b-study passes its load-factor tolerance to the limit analysis:
+/// on a structure that holds only plastically it solves fewer limit
+/// analyses than the exact study, finds the same b safe with the same
+/// elastic pressures, and records the tolerance; outside [0, 0.5) the
+/// flag is refused by name with exit code 2.
+#[test]
+fn the_b_study_spares_limit_analyses_within_its_tolerance_and_keeps_its_verdicts() {
+    use reconfcheck::mechanics::Model;
+    use reconfcheck::progress::Reporter;
+    use reconfcheck::study::b_study::{assemble, study_rows};
+    let model =
+        Model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"))
+            .unwrap();
+    let study = |tolerance: f64| {
+        let (rows, unplanned, _) = study_rows(
+            &model,
+            &[3],
+            |_| Ok(plastic_cantilever()),
+            &Reporter::silent(),
+            tolerance,
+        )
+        .unwrap();
+        assemble("cantilever", &model, rows, unplanned, tolerance)
+    };
+    let (exact, spared) = (study(0.0), study(0.05));
+    let (e, t) = (&exact.rows[0], &spared.rows[0]);
+    assert!(e.limit_analyses > 0, "{e:?}");
+    assert!(
+        t.limit_analyses < e.limit_analyses,
+        "{} vs {}",
+        t.limit_analyses,
+        e.limit_analyses
+    );
+    assert!(e.safe() && t.safe());
+    assert_eq!(exact.b_max, spared.b_max);
+    assert_eq!(
+        e.min_pressure_elastic.to_bits(),
+        t.min_pressure_elastic.to_bits()
+    );
+    assert_eq!(
+        e.min_pressure_rigid_hinge.to_bits(),
+        t.min_pressure_rigid_hinge.to_bits()
+    );
+    assert!(t.max_utilisation <= e.max_utilisation * (1.0 + 1e-9));
+    assert!(t.max_utilisation >= e.max_utilisation * (1.0 - 0.05) * (1.0 - 1e-9));
+    assert_eq!(spared.load_factor_tolerance, 0.05);
+    assert!(
+        spared.table().contains("load-factor tolerance 0.05"),
+        "{}",
+        spared.table()
+    );
+    assert!(!exact.table().contains("load-factor tolerance"));
+    for bad in ["0.5", "-0.1", "NaN"] {
+        let out = common::bin()
+            .args([
+                "b-study",
+                "--family",
+                "branch",
+                "--b-max",
+                "2",
+                "--no-progress",
+            ])
+            .arg(format!("--load-factor-tolerance={bad}"))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--load-factor-tolerance"), "{bad}: {err}");
+    }
 }
