@@ -345,10 +345,10 @@ pub fn replay_ranged<T: Send>(
     // Job 0 is the final configuration (the largest structure), then the
     // ranges last first: structures grow, so the costliest go out first.
     let jobs = starts.len() + 1;
-    let slots: Vec<Mutex<Vec<T>>> = (0..jobs).map(|_| Mutex::new(Vec::new())).collect();
+    type Found<T> = Result<Vec<T>, crate::error::InputError>;
+    let slots: Vec<Mutex<Option<Found<T>>>> = (0..jobs).map(|_| Mutex::new(None)).collect();
     let handed = AtomicUsize::new(0);
-    let first_error: Mutex<Option<(usize, crate::error::InputError)>> = Mutex::new(None);
-    let run = |job: usize| -> Result<Vec<T>, crate::error::InputError> {
+    let run = |job: usize| -> Found<T> {
         let check = fresh();
         if job == 0 {
             let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
@@ -381,28 +381,20 @@ pub fn replay_ranged<T: Send>(
                         break;
                     }
                     let job = if k == 0 { 0 } else { jobs - k };
-                    match run(job) {
-                        Ok(found) => *slots[job].lock().expect("slot") = found,
-                        Err(e) => {
-                            let mut first = first_error.lock().expect("error slot");
-                            if first.as_ref().is_none_or(|(j, _)| job < *j) {
-                                *first = Some((job, e));
-                            }
-                        }
-                    }
+                    *slots[job].lock().expect("slot") = Some(run(job));
                 }
             });
         }
     });
-    if let Some((_, e)) = first_error.into_inner().expect("error slot") {
-        return Err(e);
-    }
-    let mut slots: Vec<Vec<T>> = slots
+    // In step order (the final configuration, job 0, last); the first
+    // error in that order is returned.
+    let mut found: Vec<Found<T>> = slots
         .into_iter()
-        .map(|m| m.into_inner().expect("slot"))
+        .map(|m| m.into_inner().expect("slot").expect("every job ran"))
         .collect();
-    let last = slots.remove(0);
-    Ok(slots.into_iter().flatten().chain(last).collect())
+    found.rotate_left(1);
+    let parts = found.into_iter().collect::<Result<Vec<Vec<T>>, _>>()?;
+    Ok(parts.into_iter().flatten().collect())
 }
 
 /// The structure and its analysis at each of `steps` (1-based; `steps + 1`

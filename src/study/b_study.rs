@@ -251,7 +251,8 @@ struct StepFinding {
     no_equilibrium: bool,
     partial: bool,
     max_utilisation: f64,
-    /// The critical element, described (only where it could be the row's).
+    /// The step's critical element, described (the row keeps the one of
+    /// its worst step).
     critical: String,
     min_pressure_rigid_hinge: f64,
     min_pressure_elastic: f64,
@@ -358,11 +359,11 @@ pub fn study_rows(
             ),
             limit_analyses: 0,
         };
-        let hinge = crate::mechanics::model::Capacity {
+        let hinge = Capacity {
             bending: Bending::RigidHinge,
             ..m.connector
         };
-        let elastic = crate::mechanics::model::Capacity {
+        let elastic = Capacity {
             bending: Bending::Elastic,
             ..m.connector
         };
