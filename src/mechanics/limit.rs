@@ -25,7 +25,12 @@
 //! that no polyhedral approximation decides a verdict). `λ = 0` with zero
 //! forces is always feasible, so the answer is a number in
 //! `[0, LAMBDA_CAP]`; a solver failure gives NaN, which every caller reads
-//! as overloaded.
+//! as overloaded. The factor reported is the one [`proof`] proves from the
+//! solver's forces (equilibrium repaired exactly, capacities checked with
+//! explicit tolerances), never the solver's own `λ`, which is feasible
+//! only to the solver's tolerance.
+
+mod proof;
 
 use super::model::{Bending, Capacity, Model};
 use super::solver::Vec6;
@@ -35,6 +40,7 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SecondOrderConeT,
     SolverStatus, SupportedConeT, ZeroConeT,
 };
+use proof::EQUILIBRIUM_TOL;
 
 /// The largest load factor the analysis looks for: a structure that holds
 /// this many times its weight is reported as holding it (a structure that
@@ -70,6 +76,10 @@ pub struct LimitResult {
     pub lambda: f64,
     /// Solver iterations.
     pub iterations: u32,
+    /// The interior-point solver's own factor, before the proof
+    /// ([`proof`]): `lambda` is what an admissible field proves (at most
+    /// a round-off above this one, and 0 where nothing is proved).
+    pub solver_lambda: f64,
 }
 
 /// The load factor of `part` of `s` under `loads` (one per body of `s`,
@@ -93,9 +103,6 @@ pub struct Field {
     links: Vec<usize>,
     x: Vec<f64>,
     lambda: f64,
-    /// The largest equilibrium residual of `x / lambda` under the loads
-    /// (the solver's own tolerance): a bound built on it may not do worse.
-    residual: f64,
 }
 
 /// [`load_factor`], with the equilibrium that carries it (none for the
@@ -140,6 +147,49 @@ fn solve(
     keep_field: bool,
 ) -> (LimitResult, Option<Field>) {
     let rigid = which == Connectors::Rigid;
+    let Some((mut prog, links)) = program(s, model, loads, part, rigid) else {
+        // Held by a fixed module through rigid connectors: any load.
+        let r = LimitResult {
+            lambda: LAMBDA_CAP,
+            iterations: 0,
+            solver_lambda: LAMBDA_CAP,
+        };
+        return (r, None);
+    };
+    if rigid {
+        // Only a failing component is asked whether it stands rigidly
+        // (tips or slides): no verdict rests on this factor.
+        return (maximise(prog).0, None);
+    }
+    let to_prove = prog.clone();
+    proof::reserve_pressure(&mut prog);
+    let (mut r, x) = maximise(prog);
+    let proof = x.and_then(|x| proof::prove(&to_prove, &x, r.lambda));
+    r.solver_lambda = r.lambda;
+    if !r.lambda.is_nan() {
+        r.lambda = proof.as_ref().map_or(0.0, |p| p.lambda);
+    }
+    let field = proof
+        .filter(|p| keep_field && p.lambda > 0.0)
+        .map(|p| Field {
+            links,
+            x: p.v.iter().map(|v| v * p.lambda).collect(),
+            lambda: p.lambda,
+        });
+    (r, field)
+}
+
+/// The conic program of `part` under `loads` (equilibrium rows, capacity
+/// rows and cones; [`maximise`] adds the objective) and the links whose
+/// corners are its columns; `None` when rigid connectors to a fixed module
+/// hold the part (any load, nothing to solve).
+fn program(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    rigid: bool,
+) -> Option<(Program, Vec<usize>)> {
     let (row_of, n_groups) = equation_groups(s, part, rigid);
     let is_free = |i: usize| row_of[i] != usize::MAX;
     let origin = |i: usize| {
@@ -165,12 +215,7 @@ fn solve(
         })
         .collect();
     if rigid && links.iter().any(|&li| !s.links[li].is_ground()) {
-        // Held by a fixed module through rigid connectors: any load.
-        let r = LimitResult {
-            lambda: LAMBDA_CAP,
-            iterations: 0,
-        };
-        return (r, None);
+        return None;
     }
     let mut prog = Program::new(6 * n_groups, PER_LINK * links.len());
     let frame = Frame {
@@ -178,22 +223,8 @@ fn solve(
         origin: &origin,
     };
     equilibrium_rows(&mut prog, s, model, loads, part, &links, &frame);
-    let keep_field = keep_field && !rigid;
-    let equilibrium = keep_field.then(|| prog.clone());
     capacity_rows(&mut prog, s, model, &links);
-    let (r, x) = maximise(prog);
-    let field = x.filter(|_| r.lambda.is_finite() && r.lambda > 0.0);
-    let field = field.zip(equilibrium).map(|(x, eq)| {
-        let v: Vec<f64> = x.iter().map(|x| x / r.lambda).collect();
-        let residual = largest_residual(&eq.row_values(&v)[..eq.n_eq]);
-        Field {
-            links,
-            x,
-            lambda: r.lambda,
-            residual,
-        }
-    });
-    (r, field)
+    Some((prog, links))
 }
 
 /// The largest |value| (NaN if any is).
@@ -418,7 +449,12 @@ fn maximise(mut prog: Program) -> (LimitResult, Option<Vec<f64>>) {
             break;
         }
     }
-    (LimitResult { lambda, iterations }, x)
+    let r = LimitResult {
+        lambda,
+        iterations,
+        solver_lambda: lambda,
+    };
+    (r, x)
 }
 
 /// A lower bound of the load factor of `part` under `loads`, which differ
@@ -429,8 +465,8 @@ fn maximise(mut prog: Program) -> (LimitResult, Option<Vec<f64>>) {
 /// of a shortest path from its body to a support; the bound is the largest
 /// multiple of it within every capacity. The candidate is checked against
 /// the equilibrium equations of `loads` before it counts: 0 (no bound)
-/// where it balances them worse than the solver's own equilibrium
-/// balanced its loads. The rows are the limit analysis's own
+/// where it balances them worse than [`EQUILIBRIUM_TOL`], as a proved
+/// field balances its own (see [`proof`]). The rows are the limit analysis's own
 /// ([`equilibrium_rows`], [`capacity_rows`]), so the bound judges exactly
 /// what a solve would.
 pub fn bound_from(
@@ -517,10 +553,12 @@ pub fn bound_from(
     }
     let values = prog.row_values(&v);
     // The candidate must balance `loads` (λ = 1) on every free body as
-    // well as the solver's own equilibrium balanced its loads.
+    // a proved field balances its own.
     let residual = largest_residual(&values[..prog.n_eq]);
-    let allowed = 1.01 * field.residual + 1e-12;
-    if residual.partial_cmp(&allowed).is_none_or(|o| o.is_gt()) {
+    if residual
+        .partial_cmp(&EQUILIBRIUM_TOL)
+        .is_none_or(|o| o.is_gt())
+    {
         return 0.0;
     }
     // The largest multiple within every capacity row `lhs ≤ rhs`.
