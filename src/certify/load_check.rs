@@ -319,47 +319,106 @@ pub fn replay_ranged<T: Send>(
     visit: impl Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync,
     tick: impl Fn() + Sync,
 ) -> Result<Vec<T>, crate::error::InputError> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let model = model.at_spacing_checked(schedule.spacing.metres())?;
-    let fresh = || {
-        LoadCheck::at_spacing(model.clone(), true).with_load_factor_tolerance(load_factor_tolerance)
-    };
-    let n = schedule.steps.len();
-    let range = if range == 0 { n.max(1) } else { range };
-    // The cheap pass: the scene at each range's start, and the final one.
-    let mut world = World::initial(schedule)?;
-    let mut starts = Vec::new();
-    for k in 0..n {
-        if k % range == 0 {
-            starts.push((k, world.clone()));
+    let replay = RangedReplay::new(schedule, model, load_factor_tolerance, range)?;
+    let done = super::jobs::on_threads(&replay.order(), &|job| replay.run(job, &visit, &tick));
+    Ok(super::jobs::in_order(done, replay.jobs())?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// A schedule's replay cut into independent jobs, for whoever runs them
+/// (this process's threads, or processes): job `i < ranges` is the range
+/// of steps starting at step `i · range`, the last job the final
+/// configuration. Jobs in index order are the steps in order.
+pub struct RangedReplay<'a> {
+    schedule: &'a crate::schedule::Schedule,
+    model: Model,
+    load_factor_tolerance: f64,
+    range: usize,
+    /// The scene at each range's first step (0-based step, world).
+    starts: Vec<(usize, World)>,
+    /// The final configuration.
+    last: World,
+}
+
+impl<'a> RangedReplay<'a> {
+    /// Records, in a cheap pass (lattice only), the scene at each range's
+    /// start and the final one; a step whose moves clash is an error.
+    pub fn new(
+        schedule: &'a crate::schedule::Schedule,
+        model: &Model,
+        load_factor_tolerance: f64,
+        range: usize,
+    ) -> Result<RangedReplay<'a>, crate::error::InputError> {
+        let model = model.at_spacing_checked(schedule.spacing.metres())?;
+        let n = schedule.steps.len();
+        let range = if range == 0 { n.max(1) } else { range };
+        let mut world = World::initial(schedule)?;
+        let mut starts = Vec::new();
+        for k in 0..n {
+            if k % range == 0 {
+                starts.push((k, world.clone()));
+            }
+            let (_, _, clashes) = super::advance(&mut world, schedule, k, |_| ())?;
+            if let Some(clash) = clashes.first() {
+                return Err(crate::error::InputError::new(format!(
+                    "step {}: {}",
+                    k + 1,
+                    clash.message
+                )));
+            }
         }
-        let (_, _, clashes) = super::advance(&mut world, schedule, k, |_| ())?;
-        if let Some(clash) = clashes.first() {
-            return Err(crate::error::InputError::new(format!(
-                "step {}: {}",
-                k + 1,
-                clash.message
-            )));
-        }
+        Ok(RangedReplay {
+            schedule,
+            model,
+            load_factor_tolerance,
+            range,
+            starts,
+            last: world,
+        })
     }
-    // Job 0 is the final configuration (the largest structure), then the
-    // ranges last first: structures grow, so the costliest go out first.
-    let jobs = starts.len() + 1;
-    type Found<T> = Result<Vec<T>, crate::error::InputError>;
-    let slots: Vec<Mutex<Option<Found<T>>>> = (0..jobs).map(|_| Mutex::new(None)).collect();
-    let handed = AtomicUsize::new(0);
-    let run = |job: usize| -> Found<T> {
-        let check = fresh();
-        if job == 0 {
-            let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
+
+    /// How many jobs: the ranges and the final configuration.
+    pub fn jobs(&self) -> usize {
+        self.starts.len() + 1
+    }
+
+    /// The first step of job `job` (0-based; the final configuration's is
+    /// the number of steps): later steps have larger structures.
+    pub fn first_step(&self, job: usize) -> usize {
+        self.starts
+            .get(job)
+            .map_or(self.schedule.steps.len(), |(k, _)| *k)
+    }
+
+    /// The order to hand jobs out in: the final configuration (the
+    /// largest structure) first, then the ranges last first — structures
+    /// grow, so the costliest go out first.
+    pub fn order(&self) -> Vec<usize> {
+        (0..self.jobs()).rev().collect()
+    }
+
+    /// Runs job `job` with a fresh analyser: what `visit` keeps of each of
+    /// its steps, in step order (see [`replay_ranged`]).
+    pub fn run<T>(
+        &self,
+        job: usize,
+        visit: &(dyn Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync),
+        tick: &(dyn Fn() + Sync),
+    ) -> Result<Vec<T>, crate::error::InputError> {
+        let check = LoadCheck::at_spacing(self.model.clone(), true)
+            .with_load_factor_tolerance(self.load_factor_tolerance);
+        let n = self.schedule.steps.len();
+        let Some((first, start)) = self.starts.get(job) else {
+            let (s, a) = check.analyse(&self.last, &FxHashSet::default(), &[]);
             tick();
             return Ok(vec![visit(n + 1, &s, &a, &StepOutcome::default())]);
-        }
-        let (first, start) = &starts[job - 1];
+        };
         let mut w = start.clone();
         let mut found = Vec::new();
-        for k in *first..(first + range).min(n) {
-            let (seen, _, _) = super::advance(&mut w, schedule, k, |ctx| {
+        for k in *first..(first + self.range).min(n) {
+            let (seen, _, _) = super::advance(&mut w, self.schedule, k, |ctx| {
                 let mut out = StepOutcome::of_plan(ctx.plan);
                 super::LatticeCheck.check(ctx, &mut out);
                 let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
@@ -370,31 +429,7 @@ pub fn replay_ranged<T: Send>(
             found.push(seen);
         }
         Ok(found)
-    };
-    let threads = rayon::current_num_threads().max(1);
-    rayon::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|_| {
-                loop {
-                    let k = handed.fetch_add(1, Ordering::Relaxed);
-                    if k >= jobs {
-                        break;
-                    }
-                    let job = if k == 0 { 0 } else { jobs - k };
-                    *slots[job].lock().expect("slot") = Some(run(job));
-                }
-            });
-        }
-    });
-    // In step order (the final configuration, job 0, last); the first
-    // error in that order is returned.
-    let mut found: Vec<Found<T>> = slots
-        .into_iter()
-        .map(|m| m.into_inner().expect("slot").expect("every job ran"))
-        .collect();
-    found.rotate_left(1);
-    let parts = found.into_iter().collect::<Result<Vec<Vec<T>>, _>>()?;
-    Ok(parts.into_iter().flatten().collect())
+    }
 }
 
 /// The structure and its analysis at each of `steps` (1-based; `steps + 1`

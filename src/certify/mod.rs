@@ -8,6 +8,7 @@ pub mod atom_check;
 pub(crate) mod baseline;
 pub(crate) mod collision_check;
 pub(crate) mod docking_check;
+pub mod jobs;
 pub(crate) mod junit;
 pub(crate) mod lattice_check;
 pub(crate) mod load_check;
@@ -19,14 +20,13 @@ pub use collision_check::CollisionCheck;
 pub use docking_check::DockingCheck;
 pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
-pub use load_check::{LoadCheck, load_maps_at, replay, replay_ranged};
+pub use load_check::{LoadCheck, RangedReplay, load_maps_at, replay, replay_ranged};
 pub use report::{Report, Severity, StepResult, Violation, ViolationKind};
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;
 use crate::progress::Reporter;
 use crate::schedule::Schedule;
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -399,46 +399,25 @@ impl Ranges<'_> {
         self.starts.len()
     }
 
-    /// The range handed out `k`-th: the last first, since structures grow
-    /// over a schedule and late ranges cost the most; the cheap early ones
-    /// then fill the gaps at the end (longest job first balances workers).
-    fn in_handout_order(&self, k: usize) -> usize {
-        self.count() - 1 - k
+    /// The order ranges are handed out in: the last first, since
+    /// structures grow over a schedule and late ranges cost the most; the
+    /// cheap early ones then fill the gaps at the end (longest job first
+    /// balances workers).
+    pub fn order(&self) -> Vec<usize> {
+        (0..self.count()).rev().collect()
     }
 
-    /// The next range to hand out, counted by `handed` (shared by whoever
-    /// hands them out), or `None` once all are.
-    pub fn next_from(&self, handed: &std::sync::atomic::AtomicUsize) -> Option<usize> {
-        let k = handed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        (k < self.count()).then(|| self.in_handout_order(k))
-    }
-
-    /// Runs ranges on this process's threads, each thread taking the next
-    /// range index from `next` until it returns `None`: a shared counter
-    /// in one process, a dispatcher across processes. Returns every step's
-    /// findings (any order); after an error a thread takes no more ranges,
-    /// the others finish theirs, and the first error is returned.
-    pub fn pull(
+    /// Every step's findings, in step order, from the ranges' results
+    /// ([`jobs::Done`], as any runner returns them); the first error in
+    /// step order if a range failed.
+    pub fn findings(
         &self,
-        next: &(dyn Fn() -> Option<usize> + Sync),
+        done: jobs::Done<Vec<(usize, StepOutcome)>>,
     ) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-        let threads = rayon::current_num_threads().max(1);
-        let parts: Vec<Result<Vec<(usize, StepOutcome)>, InputError>> = (0..threads)
-            .into_par_iter()
-            .with_max_len(1)
-            .map(|_| {
-                let mut mine = Vec::new();
-                while let Some(i) = next() {
-                    mine.extend(self.run(i)?);
-                }
-                Ok(mine)
-            })
-            .collect();
-        let mut all = Vec::new();
-        for p in parts {
-            all.extend(p?);
-        }
-        Ok(all)
+        Ok(jobs::in_order(done, self.count())?
+            .into_iter()
+            .flatten()
+            .collect())
     }
 
     /// Runs range `i` (0-based): every step's findings, as (0-based step,
@@ -484,14 +463,13 @@ pub trait RangeRunner {
     fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError>;
 }
 
-/// Runs the ranges on this process's threads (rayon), handed out from a
-/// shared counter ([`Ranges::next_from`]).
+/// Runs the ranges on this process's threads (rayon), in
+/// [`Ranges::order`].
 pub struct Threads;
 
 impl RangeRunner for Threads {
     fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-        let handed = std::sync::atomic::AtomicUsize::new(0);
-        ranges.pull(&|| ranges.next_from(&handed))
+        ranges.findings(jobs::on_threads(&ranges.order(), &|i| ranges.run(i)))
     }
 }
 

@@ -64,6 +64,22 @@ fn pressure_pa(kpa: f64) -> Result<f64, InputError> {
         .map_err(|e| InputError::new(format!("--pressure (kPa): {e}")))
 }
 
+/// `RECONFCHECK_RANGE_TIMES`: one line per job of the study on standard
+/// error as it ends, with the process id (where a parallel run's time
+/// went).
+fn print_job_time(job: usize, found: &Result<Vec<b_study::StepFinding>, InputError>, s: f64) {
+    let steps = found
+        .as_ref()
+        .map_or(String::from("failed"), |f| match (f.first(), f.last()) {
+            (Some(a), Some(b)) => format!("steps {}–{}", a.step(), b.step()),
+            _ => String::from("no steps"),
+        });
+    eprintln!(
+        "b-study job {job}: {steps}, {s:.3} s (pid {})",
+        std::process::id()
+    );
+}
+
 pub fn run(a: Args) -> Result<u8, Error> {
     let tolerance = super::report::load_factor_tolerance(a.load_factor_tolerance)?;
     let mut m = Model::load(&a.model)?;
@@ -85,22 +101,31 @@ pub fn run(a: Args) -> Result<u8, Error> {
     let generate = b_study::family(&a.family, m.spacing * 1e3, a.size, a.shape.as_deref())?;
     let lengths: Vec<usize> = (b_min..=b_max).collect();
     let progress = super::progress::reporter(!a.no_progress && parallel::is_root(), 1);
-    // Each process studies its share of the b values (all of them in one
-    // process); rank 0 assembles the study from every part.
-    let mine: Vec<usize> = parallel::my_share(lengths.len(), "branch lengths")?
-        .into_iter()
-        .map(|i| lengths[i])
-        .collect();
-    let part = b_study::study_rows(&m, &mine, &generate, &progress, tolerance);
-    let (rows, unplanned, first_error) = match part {
-        Ok((rows, unplanned, first)) => (Ok(rows), Ok(unplanned), first),
-        Err(e) => (Err(e.clone()), Err(e), None),
-    };
-    let rows = parallel::gather(rows)?;
-    let unplanned = parallel::gather(unplanned)?;
-    if !parallel::is_root() {
+    let times = std::env::var_os("RECONFCHECK_RANGE_TIMES").is_some();
+    // The ranges of steps of every b are one pool of jobs for this
+    // process's threads, or for every process under MPI; rank 0 folds the
+    // rows from every part and alone writes.
+    let Some((rows, unplanned, first_error)) = b_study::study_rows(
+        &m,
+        &lengths,
+        &generate,
+        &progress,
+        tolerance,
+        &|order, job| {
+            let timed = |t: usize| {
+                let clock = std::time::Instant::now();
+                let found = job(t);
+                if times {
+                    print_job_time(t, &found, clock.elapsed().as_secs_f64());
+                }
+                found
+            };
+            parallel::run_jobs(order, &timed, "jobs (ranges of steps and final structures)")
+        },
+    )?
+    else {
         return Ok(0);
-    }
+    };
     if rows.is_empty() {
         return Err(first_error
             .unwrap_or_else(|| {

@@ -4,13 +4,15 @@
 //! gather them on rank 0, which alone writes and prints. The report is the
 //! same bytes either way: ranges and their order are the schedule's.
 
+use reconfcheck::certify::jobs::{self, Done};
 use reconfcheck::certify::{RangeRunner, Threads};
 #[cfg(feature = "mpi")]
 use reconfcheck::certify::{Ranges, StepOutcome};
 use reconfcheck::error::{Error, InputError};
+use serde::{Serialize, de::DeserializeOwned};
 use std::sync::OnceLock;
 #[cfg(feature = "mpi")]
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::AtomicUsize;
 
 /// This process's rank and the number of processes (0 of 1 without MPI).
 static PLACE: OnceLock<(usize, usize)> = OnceLock::new();
@@ -32,7 +34,8 @@ pub fn is_root() -> bool {
 /// Splits `n` independent jobs over the processes: the indices this one
 /// runs. Refused when a process would get none (it could not contribute,
 /// and the split would hide a mistake in the launch).
-pub fn my_share(n: usize, what: &str) -> Result<Vec<usize>, InputError> {
+#[cfg(feature = "mpi")]
+fn my_share(n: usize, what: &str) -> Result<Vec<usize>, InputError> {
     let (rank, size) = PLACE.get().copied().unwrap_or((0, 1));
     if n < size {
         return Err(InputError::new(format!(
@@ -49,6 +52,23 @@ pub fn runner() -> Box<dyn RangeRunner> {
         return Box::new(m);
     }
     Box::new(Threads)
+}
+
+/// Runs jobs (handed out in `order`) on this process's threads, or under
+/// MPI on every process's, and returns every job's result on rank 0;
+/// `None` on the other ranks. `what` names the jobs when there are fewer
+/// than processes (refused: a process without work hides a mistake).
+pub fn run_jobs<T: Serialize + DeserializeOwned + Send>(
+    order: &[usize],
+    job: &(dyn Fn(usize) -> Result<T, InputError> + Sync),
+    what: &str,
+) -> Result<Option<Done<T>>, InputError> {
+    #[cfg(feature = "mpi")]
+    if let Some(m) = mpi_session::world() {
+        return m.run_jobs(order, job, what);
+    }
+    let _ = what;
+    Ok(Some(jobs::on_threads(order, job)))
 }
 
 /// Runs `command` on every process and returns the exit code all of them
@@ -131,51 +151,59 @@ mod mpi_session {
         Ok(code)
     }
 
-    /// Runs the ranges over the processes and gathers them on rank 0.
+    /// Runs jobs over the processes and gathers their results on rank 0.
     ///
-    /// With MPI's full thread support, ranges are handed out one at a
-    /// time, costliest first, by a dispatcher thread on rank 0 (a range's
-    /// cost varies tenfold over a schedule, so a fixed split leaves most
-    /// processes idle behind the one with the late ranges). Without it,
-    /// rank r runs ranges r, r + N, …. Either way the findings are merged
-    /// in step order, so the report does not depend on who ran what.
+    /// With MPI's full thread support, jobs are handed out one at a time,
+    /// in the caller's order (costliest first), by a dispatcher thread on
+    /// rank 0 (a range's cost varies tenfold over a schedule, so a fixed
+    /// split leaves most processes idle behind the one with the late
+    /// ranges). Without it, rank r runs the jobs at positions r, r + N, …
+    /// of the order. Either way the results carry their job index, so what
+    /// the caller makes of them does not depend on who ran what.
     pub struct Mpi {
         dispatch: bool,
     }
 
-    impl RangeRunner for Mpi {
-        fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
-            let n = ranges.count();
+    impl Mpi {
+        pub fn run_jobs<T: Serialize + DeserializeOwned + Send>(
+            &self,
+            order: &[usize],
+            job: &(dyn Fn(usize) -> Result<T, InputError> + Sync),
+            what: &str,
+        ) -> Result<Option<Done<T>>, InputError> {
             // Every process must get work, whichever way it is handed out.
-            let share = my_share(n, "ranges of steps")?;
+            let share = my_share(order.len(), what)?;
             if !self.dispatch {
-                let mine = ranges.pull(&take_from(&share));
-                return gather(mine.map_err(|e| e.to_string()));
+                let mine: Vec<usize> = share.iter().map(|&k| order[k]).collect();
+                return gather(jobs::on_threads(&mine, job));
             }
             if comm().rank() != 0 {
-                let mine = ranges.pull(&|| ask_rank_0(&comm()));
-                return gather(mine.map_err(|e| e.to_string()));
+                return gather(jobs::pull(&|| ask_rank_0(&comm()), job));
             }
-            // Rank 0's own threads take ranges from the counter; the
+            // Rank 0's own threads take jobs from the counter; the
             // dispatcher alone talks to the other ranks (answers and
             // parts), so MPI is never called from two threads at once here.
             let handed = AtomicUsize::new(0);
+            let next = || jobs::next_in(order, &handed);
             std::thread::scope(|s| {
-                let dispatcher = s.spawn(|| serve(ranges, &handed));
-                let mine = ranges.pull(&|| ranges.next_from(&handed));
+                let dispatcher = s.spawn(|| serve(&next));
+                let mine = jobs::pull(&next, job);
                 let parts = dispatcher.join().expect("the dispatcher does not panic");
-                combine(mine.map_err(|e| e.to_string()), parts)
+                combine(mine, parts).map(Some)
             })
         }
     }
 
-    /// A fixed share, taken in order by the process's threads.
-    fn take_from(share: &[usize]) -> impl Fn() -> Option<usize> + Sync + '_ {
-        let next = AtomicUsize::new(0);
-        move || share.get(next.fetch_add(1, Ordering::Relaxed)).copied()
+    impl RangeRunner for Mpi {
+        fn run(&self, ranges: &Ranges<'_>) -> Result<Vec<(usize, StepOutcome)>, InputError> {
+            match self.run_jobs(&ranges.order(), &|i| ranges.run(i), "ranges of steps")? {
+                Some(done) => ranges.findings(done),
+                None => Ok(Vec::new()),
+            }
+        }
     }
 
-    /// One thread's request for its next range. Answers may cross between
+    /// One thread's request for its next job. Answers may cross between
     /// a process's threads; each ask gets one answer, so they balance.
     fn ask_rank_0(world: &SimpleCommunicator) -> Option<usize> {
         let root = world.process_at_rank(0);
@@ -184,11 +212,11 @@ mod mpi_session {
         usize::try_from(i).ok()
     }
 
-    /// Rank 0's dispatcher: answers every ask with the next range (or −1)
-    /// and collects the other ranks' parts, until it has them all. It
-    /// polls, sleeping between empty polls, so that it does not take a
-    /// core from the ranges.
-    fn serve(ranges: &Ranges<'_>, handed: &AtomicUsize) -> Vec<(i32, Vec<u8>)> {
+    /// Rank 0's dispatcher: answers every ask with the next job of `next`
+    /// (or −1) and collects the other ranks' parts, until it has them all.
+    /// It polls, sleeping between empty polls, so that it does not take a
+    /// core from the jobs.
+    fn serve(next: &(dyn Fn() -> Option<usize> + Sync)) -> Vec<(i32, Vec<u8>)> {
         let world = comm();
         let mut parts = Vec::new();
         while parts.len() + 1 < world.size() as usize {
@@ -204,7 +232,7 @@ mod mpi_session {
                 continue;
             }
             let _: (u8, _) = msg.matched_receive();
-            let answer = ranges.next_from(handed).map_or(-1, |i| i as i64);
+            let answer = next().map_or(-1, |i| i as i64);
             world
                 .process_at_rank(status.source_rank())
                 .send_with_tag(&answer, GIVE);
@@ -212,17 +240,18 @@ mod mpi_session {
         parts
     }
 
-    /// Sends every rank's part to rank 0, which returns them all; other
-    /// ranks return nothing. Rank 0 receives every part before it reports
-    /// any error, so that no rank is left blocked in its send.
-    pub fn gather<T: serde::Serialize + serde::de::DeserializeOwned>(
-        mine: Result<Vec<T>, String>,
-    ) -> Result<Vec<T>, InputError> {
+    /// Sends every rank's results to rank 0, which returns them all
+    /// (`None` on the other ranks). Rank 0 receives every part before it
+    /// reports anything, so that no rank is left blocked in its send.
+    fn gather<T: Serialize + DeserializeOwned>(
+        mine: Done<T>,
+    ) -> Result<Option<Done<T>>, InputError> {
         let world = comm();
-        let bytes = encode(&mine);
         if world.rank() != 0 {
-            world.process_at_rank(0).send_with_tag(&bytes[..], PART);
-            return mine.map(|_| Vec::new()).map_err(InputError::new);
+            world
+                .process_at_rank(0)
+                .send_with_tag(&encode(&mine)[..], PART);
+            return Ok(None);
         }
         let parts = (1..world.size())
             .map(|r| {
@@ -232,57 +261,46 @@ mod mpi_session {
                 )
             })
             .collect();
-        combine(mine, parts)
+        combine(mine, parts).map(Some)
     }
 
-    /// Rank 0's findings and the other ranks' encoded parts, together;
-    /// the first error if any rank had one.
-    fn combine<T: serde::de::DeserializeOwned>(
-        mine: Result<Vec<T>, String>,
+    /// Rank 0's results and the other ranks' encoded parts, together. A
+    /// job's error travels as its message and reads as on one process.
+    fn combine<T: DeserializeOwned>(
+        mut all: Done<T>,
         parts: Vec<(i32, Vec<u8>)>,
-    ) -> Result<Vec<T>, InputError> {
-        let mut all = Vec::new();
-        let mut first_error = mine.map(|m| all.extend(m)).err().map(InputError::new);
+    ) -> Result<Done<T>, InputError> {
         for (r, msg) in parts {
             let part = decode::<T>(&msg)
-                .map_err(|e| InputError::new(format!("rank {r} sent an unreadable part: {e}")))
-                .and_then(|p| p.map_err(|e| InputError::new(format!("rank {r}: {e}"))));
-            match part {
-                Ok(p) => all.extend(p),
-                Err(e) => first_error = first_error.or(Some(e)),
-            }
+                .map_err(|e| InputError::new(format!("rank {r} sent an unreadable part: {e}")))?;
+            all.extend(
+                part.into_iter()
+                    .map(|(i, res)| (i, res.map_err(InputError::new))),
+            );
         }
-        match first_error {
-            Some(e) => Err(e),
-            None => Ok(all),
-        }
+        Ok(all)
     }
-}
-
-/// Gathers the parts of a job split with [`my_share`] on rank 0 (all of
-/// them without MPI).
-pub fn gather<T: serde::Serialize + serde::de::DeserializeOwned>(
-    mine: Result<Vec<T>, InputError>,
-) -> Result<Vec<T>, InputError> {
-    #[cfg(feature = "mpi")]
-    if mpi_session::world().is_some() {
-        return mpi_session::gather(mine.map_err(|e| e.to_string()));
-    }
-    mine
 }
 
 /// A rank's part as MessagePack, with field names: the report's types skip
 /// fields at their default (a violation's `severity`, empty maps), which a
 /// positional encoding cannot tell apart from the next field.
 #[cfg(feature = "mpi")]
-fn encode<T: serde::Serialize>(part: &Result<Vec<T>, String>) -> Vec<u8> {
-    rmp_serde::to_vec_named(part).expect("parts serialise")
+fn encode<T: Serialize>(done: &Done<T>) -> Vec<u8> {
+    let wire: Vec<(usize, Result<&T, String>)> = done
+        .iter()
+        .map(|(i, r)| (*i, r.as_ref().map_err(|e| e.to_string())))
+        .collect();
+    rmp_serde::to_vec_named(&wire).expect("parts serialise")
 }
 
+/// A part as [`encode`] wrote it: each job's result, an error as its
+/// message.
 #[cfg(feature = "mpi")]
-fn decode<T: serde::de::DeserializeOwned>(
-    bytes: &[u8],
-) -> Result<Result<Vec<T>, String>, rmp_serde::decode::Error> {
+type Wire<T> = Vec<(usize, Result<T, String>)>;
+
+#[cfg(feature = "mpi")]
+fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<Wire<T>, rmp_serde::decode::Error> {
     rmp_serde::from_slice(bytes)
 }
 
@@ -304,12 +322,18 @@ mod tests {
         };
         let report = certify(&s, &opts).unwrap();
         assert!(!report.violations.is_empty());
-        let part: Result<Vec<_>, String> = Ok(report.violations.clone());
-        let back: Result<Vec<reconfcheck::certify::Violation>, String> =
-            decode(&encode(&part)).unwrap();
+        let part: Done<Vec<_>> = vec![
+            (3, Ok(report.violations.clone())),
+            (5, Err(InputError::new("step 7: clash"))),
+        ];
+        let back: Wire<Vec<reconfcheck::certify::Violation>> = decode(&encode(&part)).unwrap();
+        assert_eq!(back[0].0, 3);
         assert_eq!(
-            serde_json::to_string(&back.unwrap()).unwrap(),
+            serde_json::to_string(back[0].1.as_ref().unwrap()).unwrap(),
             serde_json::to_string(&report.violations).unwrap()
         );
+        // An error comes back as its message.
+        assert_eq!(back[1].0, 5);
+        assert_eq!(back[1].1.as_ref().unwrap_err(), "step 7: clash");
     }
 }

@@ -10,8 +10,9 @@
 //! bending criteria, and `b_max(p)` for any `p` follows without
 //! re-solving.
 
+use crate::certify::RangedReplay;
 use crate::certify::StepOutcome;
-use crate::certify::load_check::replay_ranged;
+use crate::certify::jobs::{self, Done};
 use crate::certify::report::ViolationKind;
 use crate::error::InputError;
 use crate::mechanics::analysis::{Analysis, Critical, Verdict};
@@ -226,10 +227,10 @@ pub fn sweep_pressures() -> Vec<f64> {
 }
 
 /// Runs the study for `lengths` with `generate(b)` producing the schedule;
-/// `progress` hears of every schedule's steps, one phase per `b` (a
-/// scaffold of the sandcastle's size takes minutes per `b`). A `b` the generator
-/// cannot plan is recorded in [`Study::unplanned`] and the study goes on;
-/// if no `b` can be planned, the first error is returned.
+/// `progress` hears of every schedule's steps, in one phase for all `b`
+/// (a scaffold of the sandcastle's size takes minutes per `b`). A `b` the
+/// generator cannot plan is recorded in [`Study::unplanned`] and the
+/// study goes on; if no `b` can be planned, the first error is returned.
 pub fn b_study(
     family: &str,
     model: &Model,
@@ -237,15 +238,19 @@ pub fn b_study(
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
 ) -> Result<Study, InputError> {
-    let (rows, unplanned, first_error) = study_rows(model, lengths, generate, progress, 0.0)?;
+    let (rows, unplanned, first_error) =
+        study_rows(model, lengths, generate, progress, 0.0, &on_threads)?
+            .expect("this process's threads fold the rows");
     if let (true, Some(e)) = (rows.is_empty(), first_error) {
         return Err(e);
     }
     Ok(assemble(family, model, rows, unplanned, 0.0))
 }
 
-/// What the study keeps of one step's analysis.
-struct StepFinding {
+/// What the study keeps of one step's analysis (sent between processes
+/// when a study runs over MPI).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct StepFinding {
     step: usize,
     lattice_violations: usize,
     no_equilibrium: bool,
@@ -260,6 +265,12 @@ struct StepFinding {
 }
 
 impl StepFinding {
+    /// The step (1-based; the schedule's steps + 1 is its final
+    /// configuration).
+    pub fn step(&self) -> usize {
+        self.step
+    }
+
     fn of(
         step: usize,
         s: &Structure,
@@ -306,59 +317,59 @@ impl StepFinding {
     }
 }
 
+/// Runs jobs (indices into one table of every b's ranges, handed out in
+/// the order given) and returns what they found on the process that folds
+/// the rows; `None` on the others (MPI ranks other than 0).
+pub type Runner<'r> = &'r dyn Fn(
+    &[usize],
+    &(dyn Fn(usize) -> Result<Vec<StepFinding>, InputError> + Sync),
+) -> Result<Option<Done<Vec<StepFinding>>>, InputError>;
+
+/// The [`Runner`] of this process's threads.
+pub fn on_threads(
+    order: &[usize],
+    job: &(dyn Fn(usize) -> Result<Vec<StepFinding>, InputError> + Sync),
+) -> Result<Option<Done<Vec<StepFinding>>>, InputError> {
+    Ok(Some(jobs::on_threads(order, job)))
+}
+
 /// The rows of the b values in `lengths`, each from checking every step of
 /// its schedule; the b values the generator could not plan, and the first
-/// such error. Each b is independent of the others: a study may be split
-/// over processes by b and [`assemble`]d from the parts.
+/// such error. Every b's steps are cut into ranges as certification cuts
+/// them ([`RangedReplay`]), and the ranges of all b are one pool of jobs
+/// for `runner` — the final structures first, then the ranges from the
+/// latest steps down — so that any number of threads or processes share
+/// the work, one b or many. Each step's findings are folded in step order:
+/// the rows do not depend on who ran what. `None` where `runner` returns
+/// none (a process that does not fold).
 pub fn study_rows(
     model: &Model,
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
     load_factor_tolerance: f64,
-) -> Result<StudyRows, InputError> {
-    let mut rows = Vec::new();
+    runner: Runner<'_>,
+) -> Result<Option<StudyRows>, InputError> {
+    let mut planned = Vec::new();
     let mut unplanned = Vec::new();
     let mut first_error = None;
     for &b in lengths {
-        let schedule = match generate(b) {
-            Ok(s) => s,
+        match generate(b) {
+            Ok(s) => planned.push((b, s)),
             Err(e) => {
                 unplanned.push(Unplanned {
                     b,
                     reason: e.to_string(),
                 });
                 first_error.get_or_insert(e);
-                continue;
             }
-        };
-        let bar = progress;
-        bar.start(&format!("b = {b}"), (schedule.steps.len() + 1) as u64);
+        }
+    }
+    let mut studied = Vec::new();
+    for (b, schedule) in &planned {
         let m = model.at_spacing_checked(schedule.spacing.metres())?;
-        let mut row = Row {
-            b,
-            steps: schedule.steps.len(),
-            lattice_violations: 0,
-            max_utilisation: 0.0,
-            max_utilisation_at_least: false,
-            critical_step: 0,
-            critical_connector: String::new(),
-            no_equilibrium: false,
-            min_pressure_rigid_hinge: 0.0,
-            min_pressure_elastic: 0.0,
-            closed_utilisation: closed_form::cantilever_utilisation(&m, b.saturating_sub(1), true),
-            closed_pressure_rigid_hinge: closed_form::cantilever_pressure(
-                &m.with_connector(m.connector.pressure, Bending::RigidHinge),
-                b.saturating_sub(1),
-                true,
-            ),
-            closed_pressure_elastic: closed_form::cantilever_pressure(
-                &m.with_connector(m.connector.pressure, Bending::Elastic),
-                b.saturating_sub(1),
-                true,
-            ),
-            limit_analyses: 0,
-        };
+        let range = crate::certify::default_range_steps(schedule.steps.len());
+        let replay = RangedReplay::new(schedule, &m, load_factor_tolerance, range)?;
         let hinge = Capacity {
             bending: Bending::RigidHinge,
             ..m.connector
@@ -367,40 +378,110 @@ pub fn study_rows(
             bending: Bending::Elastic,
             ..m.connector
         };
-        // Ranges of steps run in parallel (as in certification), each
-        // step's findings folded in step order: the row is the same on any
-        // number of threads.
-        let range = crate::certify::default_range_steps(schedule.steps.len());
-        let findings = replay_ranged(
-            &schedule,
-            &m,
-            load_factor_tolerance,
+        studied.push((
+            empty_row(*b, schedule.steps.len(), &m),
+            replay,
+            hinge,
+            elastic,
+        ));
+    }
+    // One table of (b, job) in b order, jobs in step order; handed out
+    // final structures first (largest b first), then ranges by their
+    // first step, latest first.
+    let table: Vec<(usize, usize)> = studied
+        .iter()
+        .enumerate()
+        .flat_map(|(r, (_, replay, _, _))| (0..replay.jobs()).map(move |j| (r, j)))
+        .collect();
+    let mut order: Vec<usize> = (0..table.len()).collect();
+    order.sort_by_key(|&t| {
+        let (r, j) = table[t];
+        let replay = &studied[r].1;
+        let range = j + 1 < replay.jobs();
+        (
             range,
-            |step, s, a, out| StepFinding::of(step, s, a, out, &hinge, &elastic),
-            || bar.advance(1),
-        )?;
-        for f in findings {
-            row.lattice_violations += f.lattice_violations;
-            row.limit_analyses += f.limit_analyses;
-            row.no_equilibrium |= f.no_equilibrium;
-            row.max_utilisation_at_least |= f.partial;
-            if f.max_utilisation > row.max_utilisation {
-                row.max_utilisation = f.max_utilisation;
-                row.critical_step = f.step;
-                row.critical_connector = f.critical;
-            }
-            row.min_pressure_rigid_hinge =
-                row.min_pressure_rigid_hinge.max(f.min_pressure_rigid_hinge);
-            row.min_pressure_elastic = row.min_pressure_elastic.max(f.min_pressure_elastic);
+            std::cmp::Reverse((replay.first_step(j), studied[r].0.b)),
+        )
+    });
+    let total: usize = planned.iter().map(|(_, s)| s.steps.len() + 1).sum();
+    let bs: Vec<String> = planned.iter().map(|(b, _)| b.to_string()).collect();
+    progress.start(&format!("b = {}", bs.join(", ")), total as u64);
+    let job = |t: usize| {
+        let (r, j) = table[t];
+        let (_, replay, hinge, elastic) = &studied[r];
+        replay.run(
+            j,
+            &|step, s, a, out| StepFinding::of(step, s, a, out, hinge, elastic),
+            &|| progress.advance(1),
+        )
+    };
+    let Some(done) = runner(&order, &job)? else {
+        return Ok(None);
+    };
+    progress.finish();
+    // In table order, b by b, each b's steps in order (final last).
+    let mut found = jobs::in_order(done, table.len())?.into_iter();
+    let mut rows = Vec::new();
+    for (mut row, replay, _, _) in studied {
+        for f in found.by_ref().take(replay.jobs()).flatten() {
+            row.fold(f);
         }
-        bar.finish();
         if row.no_equilibrium {
             row.min_pressure_rigid_hinge = f64::INFINITY;
             row.min_pressure_elastic = f64::INFINITY;
         }
         rows.push(row);
     }
-    Ok((rows, unplanned, first_error))
+    Ok(Some((rows, unplanned, first_error)))
+}
+
+/// A row before any step is folded in: the closed forms of `b − 1`
+/// modules and the agent.
+fn empty_row(b: usize, steps: usize, m: &Model) -> Row {
+    Row {
+        b,
+        steps,
+        lattice_violations: 0,
+        max_utilisation: 0.0,
+        max_utilisation_at_least: false,
+        critical_step: 0,
+        critical_connector: String::new(),
+        no_equilibrium: false,
+        min_pressure_rigid_hinge: 0.0,
+        min_pressure_elastic: 0.0,
+        closed_utilisation: closed_form::cantilever_utilisation(m, b.saturating_sub(1), true),
+        closed_pressure_rigid_hinge: closed_form::cantilever_pressure(
+            &m.with_connector(m.connector.pressure, Bending::RigidHinge),
+            b.saturating_sub(1),
+            true,
+        ),
+        closed_pressure_elastic: closed_form::cantilever_pressure(
+            &m.with_connector(m.connector.pressure, Bending::Elastic),
+            b.saturating_sub(1),
+            true,
+        ),
+        limit_analyses: 0,
+    }
+}
+
+impl Row {
+    /// Folds one step's finding in (steps in order: the worst step is the
+    /// first to reach the row's maximum).
+    fn fold(&mut self, f: StepFinding) {
+        self.lattice_violations += f.lattice_violations;
+        self.limit_analyses += f.limit_analyses;
+        self.no_equilibrium |= f.no_equilibrium;
+        self.max_utilisation_at_least |= f.partial;
+        if f.max_utilisation > self.max_utilisation {
+            self.max_utilisation = f.max_utilisation;
+            self.critical_step = f.step;
+            self.critical_connector = f.critical;
+        }
+        self.min_pressure_rigid_hinge = self
+            .min_pressure_rigid_hinge
+            .max(f.min_pressure_rigid_hinge);
+        self.min_pressure_elastic = self.min_pressure_elastic.max(f.min_pressure_elastic);
+    }
 }
 
 /// The study of `family` from its rows (any order) and its unplanned b
@@ -762,6 +843,51 @@ mod tests {
         let last = &c[c.rfind('(').expect("cells") + 1..];
         let last = &last[..last.find(')').expect("cells")];
         last.rsplit(", ").next().unwrap().parse().unwrap()
+    }
+
+    #[test]
+    fn the_rows_do_not_depend_on_who_ran_which_range_nor_in_what_order() {
+        // Two b values, one overloaded (limit analyses, a critical step):
+        // on this process's threads, and split as two processes would be
+        // (even and odd positions of the order, each run backwards, the
+        // parts concatenated as rank 0 receives them).
+        let model = Model::default_catom();
+        let rows = |runner: Runner<'_>| {
+            let generate = family("pyramid", 3.6, Some(2), None).unwrap();
+            let (rows, unplanned, _) =
+                study_rows(&model, &[6, 9], generate, &Reporter::silent(), 0.0, runner)
+                    .unwrap()
+                    .expect("this runner folds");
+            assert!(unplanned.is_empty());
+            format!("{rows:?}")
+        };
+        let split =
+            |order: &[usize],
+             job: &(dyn Fn(usize) -> Result<Vec<StepFinding>, InputError> + Sync)| {
+                let mut done = Vec::new();
+                for parity in [1, 0] {
+                    let mine: Vec<usize> = order
+                        .iter()
+                        .enumerate()
+                        .filter(|(k, _)| k % 2 == parity)
+                        .map(|(_, &t)| t)
+                        .rev()
+                        .collect();
+                    done.extend(mine.into_iter().map(|t| (t, job(t))));
+                }
+                Ok(Some(done))
+            };
+        let threads = rows(&on_threads);
+        assert!(threads.contains("limit_analyses: ") && threads.contains("b: 9"));
+        assert_eq!(threads, rows(&split));
+        // A runner that loses a job is an error, not a short row.
+        let lossy =
+            |order: &[usize],
+             job: &(dyn Fn(usize) -> Result<Vec<StepFinding>, InputError> + Sync)| {
+                Ok(Some(order[1..].iter().map(|&t| (t, job(t))).collect()))
+            };
+        let generate = family("pyramid", 3.6, Some(2), None).unwrap();
+        assert!(study_rows(&model, &[6], generate, &Reporter::silent(), 0.0, &lossy).is_err());
     }
 
     #[test]

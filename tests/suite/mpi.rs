@@ -151,19 +151,63 @@ fn two_processes_study_the_same_branch_lengths_as_one() {
 #[cfg(feature = "mpi")]
 #[test]
 fn more_processes_than_work_is_refused_not_a_hang() {
+    // One short branch: one range of steps and the final structure.
     let b = mpirun(
         3,
         &[
             "b-study",
             "--family=branch",
             "--b-min=1",
-            "--b-max=2",
+            "--b-max=1",
             "--no-progress",
         ],
     );
     assert_eq!(b.status.code(), Some(2));
     let err = String::from_utf8_lossy(&b.stderr);
-    assert!(err.contains("3 processes for 2 branch lengths"), "{err}");
+    assert!(
+        err.contains("3 processes for 2 jobs (ranges of steps and final structures)"),
+        "{err}"
+    );
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn three_processes_share_the_ranges_of_one_branch_length() {
+    // One b, more processes than b values: the processes share its ranges
+    // of steps (the 2-pyramid at b = 9 is overloaded from step 84 on, so
+    // limit analyses and critical steps travel between ranks).
+    let (one, three) = (scratch("b9-1.json"), scratch("b9-3.json"));
+    let args = |p: &PathBuf| {
+        vec![
+            "b-study".to_string(),
+            "--family=pyramid".into(),
+            "--size=2".into(),
+            "--b-min=9".into(),
+            "--b-max=9".into(),
+            "--no-progress".into(),
+            format!("--json={}", p.display()),
+        ]
+    };
+    let (a1, a3) = (args(&one), args(&three));
+    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
+    let b = mpirun(3, &a3.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(a.status.code(), Some(0));
+    assert_eq!(
+        b.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
+    let study = std::fs::read(&one).unwrap();
+    assert!(
+        String::from_utf8_lossy(&study).contains("\"limit_analyses\""),
+        "the rows were studied"
+    );
+    assert!(
+        study == std::fs::read(&three).unwrap(),
+        "the studies differ"
+    );
+    assert_eq!(a.stdout, b.stdout);
 }
 
 #[cfg(not(feature = "mpi"))]
