@@ -100,6 +100,15 @@ pub struct Analysis {
     pub load_factor_lower: Option<f64>,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
+    /// Intervals between two samples whose poses between samples were
+    /// judged one by one ([`Structure::between`]); the others were cleared
+    /// by a bound of the whole interval.
+    pub between_poses: usize,
+    /// Components judged at the samples alone: their loads were solved
+    /// pose by pose (more movers than superposition pays for), or their
+    /// movers turn at more than `MAX_HULL_GROUPS` (3)
+    /// rates. Between their samples the verdict is not proved.
+    pub sampled_only: usize,
     pub critical: Option<Critical>,
     pub verdict: Option<Verdict>,
     /// CG iterations (preconditioned by a kept factor, or refining a fresh
@@ -127,6 +136,12 @@ struct Screen {
     admissible: f64,
     /// Displacements at the reference pose (the next step's warm start).
     q_reference: Vec<Vec6>,
+    /// Poses between samples judged one by one (where the bound of their
+    /// interval did not clear them).
+    between_judged: usize,
+    /// Movers hang on the component but its poses between samples were
+    /// not judged (see [`Analysis::sampled_only`]).
+    sampled_only: bool,
 }
 
 /// The settled elastic equilibrium of one component (see
@@ -362,7 +377,7 @@ fn mover_moment(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
     let p = s.bodies[hg.pivot].centre;
     let g = s.gravity;
     let r = match pose {
-        Some(k) => hg.path[k.min(hg.path.len() - 1)] - p,
+        Some(k) => s.mover_point(h, k) - p,
         None => worst_lever(hg.path.iter().map(|c| *c - p), g),
     };
     r.cross(g)
@@ -558,6 +573,8 @@ impl Analyzer {
             for (&li, r) in comps.links[c].iter().zip(&screen.links) {
                 out.links[li] = *r;
             }
+            out.between_poses += screen.between_judged;
+            out.sampled_only += usize::from(screen.sampled_only);
             if !screen.failing.is_empty() {
                 let mut limit = self.limit(s, &comps, c, &screen.failing);
                 limit.admissible = screen.admissible;
@@ -603,6 +620,7 @@ impl Analyzer {
             .filter(|&h| local[s.hanging[h].pivot] != u32::MAX)
             .collect();
         let n_poses = movers.iter().map(|&h| s.hanging[h].path.len()).max();
+        let n_samples = n_poses.unwrap_or(0);
         let poses: Vec<Option<usize>> = match n_poses {
             Some(n) if self.settings.envelope => (0..n).map(Some).collect(),
             _ => vec![None],
@@ -611,6 +629,7 @@ impl Analyzer {
             // Whether the component stands is for the limit analysis to
             // say, at every pose.
             screen.links = vec![LinkResult::default(); links.len()];
+            screen.sampled_only = poses.len() > 1;
             screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
         };
         if !st.anchored || !st.converged {
@@ -716,7 +735,7 @@ impl Analyzer {
                         }
                     }
                 }
-                Some(p) => sf = sf_of(&solutions[p]),
+                Some(_) => sf = sf_of(&solutions[i]),
             }
             let sf_link = |li: usize| &sf[slot[li]];
             let judged = self.judge_pose(s, links, &st, &sf_link, i == 0, &mut screen.links);
@@ -729,6 +748,34 @@ impl Analyzer {
                     .push((pose, judged.worst.max(severity(judged.scale))));
             } else {
                 screen.admissible = screen.admissible.max(judged.worst);
+            }
+        }
+        let judged_between = superpose && !s.between.is_empty();
+        screen.sampled_only = n_samples > 1 && self.settings.envelope && !judged_between;
+        if judged_between {
+            // Between samples: the poses of `Structure::between` whose
+            // loads may reach the corner gate are judged for the verdict.
+            let per_interval = s.between.len() / (n_samples - 1);
+            for i in 0..n_samples - 1 {
+                if !self.interval_clear(s, &active, &sf_reference, &basis, i) {
+                    for v in i * per_interval..(i + 1) * per_interval {
+                        let pose = Some(n_samples + v);
+                        sf.clone_from(&sf_reference);
+                        for (h, e, reference, sf_b) in &basis {
+                            let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
+                            sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
+                        }
+                        let sf_link = |li: usize| &sf[slot[li]];
+                        let mut scratch = vec![LinkResult::default(); links.len()];
+                        let judged = self.judge_pose(s, links, &st, &sf_link, true, &mut scratch);
+                        screen.between_judged += 1;
+                        if overloaded(judged.worst) || overloaded(judged.gate) {
+                            screen
+                                .failing
+                                .push((pose, judged.worst.max(severity(judged.scale))));
+                        }
+                    }
+                }
             }
         }
         screen.failing.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -929,6 +976,65 @@ impl Analyzer {
             }
         }
         j_out
+    }
+
+    /// Whether every pose between samples `i` and `i + 1` is cleared by one
+    /// bound: a pose there moves each group of movers to sample `i + 1` or
+    /// to the tangent point, which adds to each link's load at sample `i`
+    /// the group's share of the change; with every component of those
+    /// shares at its largest magnitude (the utilisation grows with each
+    /// of the tension, shear, torsion and bending magnitudes), the link
+    /// stays below the utilisation at which the corner construction always
+    /// carries it (`CORNER_FREE_BELOW`): an elastic witness at every such
+    /// pose. `basis`: per unit solution its mover, axis, reference moment
+    /// and interface forces (of the `active` links).
+    fn interval_clear(
+        &self,
+        s: &Structure,
+        active: &[usize],
+        sf_reference: &[Vec6],
+        basis: &[(usize, DVec3, DVec3, Vec<Vec6>)],
+        i: usize,
+    ) -> bool {
+        let groups = s.hanging.iter().map(|h| h.group + 1).max().unwrap_or(0);
+        let zero = vec![Vec6::zeros(); active.len()];
+        let mut at_i = sf_reference.to_vec();
+        let mut share = vec![[zero.clone(), zero]; groups];
+        for (h, e, reference, sf_b) in basis {
+            let hg = &s.hanging[*h];
+            let p = s.bodies[hg.pivot].centre;
+            let m = |c: DVec3| (c - p).cross(s.gravity);
+            let m_i = m(hg.path[i]);
+            let c = (m_i - *reference).dot(*e);
+            let c1 = (m(hg.path[i + 1]) - m_i).dot(*e);
+            let ct = (m(hg.hull[i]) - m_i).dot(*e);
+            let [to_next, to_tangent] = &mut share[hg.group];
+            for (j, y) in sf_b.iter().enumerate() {
+                at_i[j] += c * y;
+                to_next[j] += c1 * y;
+                to_tangent[j] += ct * y;
+            }
+        }
+        active.iter().enumerate().all(|(j, &li)| {
+            let l = &s.links[li];
+            let base = self.load_of(l, &at_i[j]).0;
+            let mut worst = ConnectorLoad {
+                axial: base.axial,
+                shear: base.shear,
+                torsion: base.torsion.abs(),
+                moment_u: base.moment_u.abs(),
+                moment_v: base.moment_v.abs(),
+            };
+            for [a, b] in &share {
+                let (a, b) = (self.load_of(l, &a[j]).0, self.load_of(l, &b[j]).0);
+                worst.axial += a.axial.abs().max(b.axial.abs());
+                worst.shear += a.shear.max(b.shear);
+                worst.torsion += a.torsion.abs().max(b.torsion.abs());
+                worst.moment_u += a.moment_u.abs().max(b.moment_u.abs());
+                worst.moment_v += a.moment_v.abs().max(b.moment_v.abs());
+            }
+            utilisation(&worst, self.capacity(l)).0 <= CORNER_FREE_BELOW
+        })
     }
 
     /// One link's result from its interface force `sf` (units `W`, `W·d`).

@@ -66,6 +66,83 @@ pub struct Hanging {
     pub pivot: usize,
     /// Sampled centres of the mover along its motion, in units of `d`.
     pub path: Vec<DVec3>,
+    /// Between each two consecutive samples, the point where the motion's
+    /// tangents at them meet ([`tangent_points`]): the arc between the two
+    /// lies in the triangle of the three, so a load affine in the mover's
+    /// centre lies, all along the motion, in the convex hull of its values
+    /// at the samples and at these points.
+    pub hull: Vec<DVec3>,
+    /// Movers whose paths turn by the same angle between every two
+    /// samples form a group ([`Structure::between`]).
+    pub group: usize,
+}
+
+/// Where a group of movers stands at a pose between samples `i` and
+/// `i + 1`.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Point {
+    Sample(usize),
+    Tangent(usize),
+}
+
+/// At most this many groups get poses between samples: each interval has
+/// `3^G − 2` of them.
+pub const MAX_HULL_GROUPS: usize = 3;
+
+/// The tangent points of a path sampled on circular arcs about `centre`
+/// (each pair of consecutive samples on one arc, less than a half turn
+/// apart), or of a straight path (`None`: the midpoints). For samples at
+/// `p + u₁`, `p + u₂` with `|u₁| = |u₂| = r`, the tangents meet at
+/// `p + 2r²(u₁ + u₂)/|u₁ + u₂|²`, a factor `1/cos(δ/2)` beyond the arc's
+/// middle (δ: the angle between the samples).
+pub fn tangent_points(path: &[DVec3], centre: Option<DVec3>) -> Vec<DVec3> {
+    path.windows(2)
+        .map(|w| match centre {
+            Some(p) => {
+                let (u1, u2) = (w[0] - p, w[1] - p);
+                let sum = u1 + u2;
+                let r2 = u1.length() * u2.length();
+                if sum.length_squared() <= 1e-24 {
+                    // Opposite samples: no half turn has them (not made).
+                    0.5 * (w[0] + w[1])
+                } else {
+                    p + 2.0 * r2 * sum / sum.length_squared()
+                }
+            }
+            None => 0.5 * (w[0] + w[1]),
+        })
+        .collect()
+}
+
+/// The poses between `samples` samples for `groups` groups (see
+/// [`Structure::between`]), interval by interval.
+fn between_poses(samples: usize, groups: usize) -> Vec<Vec<Point>> {
+    let mut out = Vec::new();
+    for i in 0..samples.saturating_sub(1) {
+        let choices = [Point::Sample(i), Point::Sample(i + 1), Point::Tangent(i)];
+        for code in 0..3usize.pow(groups as u32) {
+            let pose: Vec<Point> = (0..groups)
+                .map(|g| choices[code / 3usize.pow(g as u32) % 3])
+                .collect();
+            let all_one_sample = pose.iter().all(|p| *p == pose[0]) && pose[0] != choices[2];
+            if !all_one_sample {
+                out.push(pose);
+            }
+        }
+    }
+    out
+}
+
+/// The centre of the arcs a motion's path follows (`None`: straight or no
+/// path): the pivot of a rotation, the corner pivot of a slide around one.
+pub fn arc_centre(lattice: &dyn Lattice, motion: &Motion) -> Option<DVec3> {
+    match motion {
+        Motion::Rotate { pivot, .. } => Some(lattice.centre(*pivot)),
+        Motion::Slide { to, pivot, .. } => pivot
+            .filter(|p| lattice.are_neighbours(*p, *to))
+            .map(|p| lattice.centre(p)),
+        Motion::Tunnel { .. } => None,
+    }
 }
 
 /// A configuration as a mechanical structure.
@@ -76,6 +153,15 @@ pub struct Structure {
     pub hanging: Vec<Hanging>,
     /// Unit vector of gravity.
     pub gravity: DVec3,
+    /// The poses between samples (pose `path.len() + v` is `between[v]`,
+    /// one `Point` per group), interval by interval, `3^G − 2` each: the
+    /// corners of the product of every group's triangles (two samples and
+    /// their tangent point) but the two samples themselves. Movers of one
+    /// group turn at the same rate, so their joint path between two
+    /// samples is one planar ellipse arc, inside its triangle; the joint
+    /// path of all movers lies in the product, the convex hull of these
+    /// corners. Empty beyond `MAX_HULL_GROUPS` groups.
+    pub between: Vec<Vec<Point>>,
     index: FxHashMap<ModuleId, usize>,
 }
 
@@ -182,8 +268,11 @@ pub struct SceneRef<'a> {
 }
 
 /// Samples per mover path: fine enough that the worst lever of a 60°/90°
-/// arc is found within 0.2 %.
+/// arc is found within 0.2 %. Odd, so that a rotation's two arcs meet at a
+/// sample (`s = ½`) and every pair of consecutive samples lies on one arc
+/// (what [`tangent_points`] needs).
 pub const PATH_SAMPLES: usize = 25;
+const _: () = assert!(PATH_SAMPLES % 2 == 1);
 
 impl Structure {
     /// The static structure of a scene with `movers` hanging on their pivots.
@@ -237,20 +326,58 @@ impl Structure {
                 });
             }
         }
+        let mut signatures: Vec<Vec<i64>> = Vec::new();
         for (m, pivot, motion) in movers {
             let Some(&pi) = pivot.as_ref().and_then(|p| s.index.get(p)) else {
                 continue;
             };
             let path = mover_path(lattice, motion, PATH_SAMPLES);
             if !path.is_empty() {
+                let centre = arc_centre(lattice, motion);
+                let hull = tangent_points(&path, centre);
+                // Turning angles, to 1e-9 rad, name the group.
+                let turns: Vec<i64> = path
+                    .windows(2)
+                    .map(|w| {
+                        centre.map_or(0, |p| {
+                            ((w[0] - p).angle_between(w[1] - p) * 1e9).round() as i64
+                        })
+                    })
+                    .collect();
+                let group = match signatures.iter().position(|t| *t == turns) {
+                    Some(g) => g,
+                    None => {
+                        signatures.push(turns);
+                        signatures.len() - 1
+                    }
+                };
                 s.hanging.push(Hanging {
                     mover: *m,
                     pivot: pi,
                     path,
+                    hull,
+                    group,
                 });
             }
         }
+        if (1..=MAX_HULL_GROUPS).contains(&signatures.len()) {
+            s.between = between_poses(PATH_SAMPLES, signatures.len());
+        }
         s
+    }
+
+    /// Mover `h`'s centre at pose `k`: sample `k` of its path, or a pose
+    /// between samples ([`Structure::between`]).
+    pub fn mover_point(&self, h: usize, k: usize) -> DVec3 {
+        let hg = &self.hanging[h];
+        let n = hg.path.len();
+        if k < n {
+            return hg.path[k];
+        }
+        match self.between[k - n][hg.group] {
+            Point::Sample(i) => hg.path[i],
+            Point::Tangent(i) => hg.hull[i],
+        }
     }
 
     pub fn body_of(&self, m: ModuleId) -> Option<usize> {

@@ -507,3 +507,77 @@ fn the_b_study_spares_limit_analyses_within_its_tolerance_and_keeps_its_verdicts
         assert!(err.contains("--load-factor-tolerance"), "{bad}: {err}");
     }
 }
+
+/// A certifier must not certify what a finer analysis rejects, between the
+/// samples of a move too. Step 169 of the default scenario (5 movers
+/// turning at two rates) is judged at 25 samples per move; walked densely
+/// (16 points per interval, on the true arcs), its worst connector is
+/// about 2e-4 more loaded. The poses between samples the analysis judges
+/// (`Structure::between`: per interval, every group of movers at either
+/// sample or at its tangent point) bound that walk from above, closely:
+/// analysed as poses of their own, their worst connector is at least the
+/// dense walk's and within 0.1 % of it.
+#[test]
+fn the_poses_between_samples_bound_a_dense_walk_of_the_moves() {
+    use reconfcheck::algorithms::scaffold::{ShapeSpec, scaffold_schedule};
+    use reconfcheck::certify::load_maps_at;
+    use reconfcheck::mechanics::{Analyzer, Model, Structure};
+    let schedule = scaffold_schedule(&ShapeSpec::Pyramid { h: 3 }, 6).unwrap();
+    let model =
+        Model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"))
+            .unwrap()
+            .at_spacing_checked(schedule.spacing.metres())
+            .unwrap();
+    let (_, built, a) = load_maps_at(&schedule, &model, &[169]).unwrap().remove(0);
+    let groups = built.hanging.iter().map(|h| h.group).max().unwrap() + 1;
+    assert!(built.hanging.len() == 5 && groups == 2, "{groups} groups");
+    assert_eq!(built.between.len(), 24 * (9 - 2));
+    // Every interval was cleared by its bound (nothing near capacity).
+    assert_eq!((a.between_poses, a.sampled_only), (0, 0));
+    // Each structure's movers walk the given points, at a common index.
+    let walking = |points: &dyn Fn(usize) -> Vec<glam::DVec3>| {
+        let mut t = built.clone();
+        t.between.clear();
+        for (h, hg) in t.hanging.iter_mut().enumerate() {
+            hg.path = points(h);
+            hg.hull.clear();
+        }
+        t
+    };
+    let dense = walking(&|h| {
+        let hg = &built.hanging[h];
+        let c = built.bodies[hg.pivot].centre;
+        let mut path = Vec::new();
+        for w in hg.path.windows(2) {
+            let (u1, u2) = (w[0] - c, w[1] - c);
+            let ang = u1.angle_between(u2);
+            for j in 0..16 {
+                let t = j as f64 / 16.0;
+                path.push(c + (u1 * ((1.0 - t) * ang).sin() + u2 * (t * ang).sin()) / ang.sin());
+            }
+        }
+        path.push(*hg.path.last().unwrap());
+        path
+    });
+    let corners = walking(&|h| {
+        let n = built.hanging[h].path.len();
+        (0..n + built.between.len())
+            .map(|k| built.mover_point(h, k))
+            .collect()
+    });
+    let worst = |s: &Structure| {
+        Analyzer::new(model.clone(), false)
+            .analyse(s)
+            .max_utilisation
+    };
+    let (at_samples, on_walk, at_corners) = (a.max_utilisation, worst(&dense), worst(&corners));
+    assert!(
+        on_walk > at_samples * (1.0 + 1e-4),
+        "{on_walk} vs {at_samples}"
+    );
+    assert!(
+        at_corners >= on_walk,
+        "{at_corners} < {on_walk}: the walk leaves the hull"
+    );
+    assert!(at_corners <= on_walk * 1.001, "{at_corners} ≫ {on_walk}");
+}
