@@ -42,29 +42,52 @@ fn alone(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// Runs `args(one)` alone and `args(many)` on `n` processes: both exit
+/// with `code`, print the same, and write the same bytes, which contain
+/// `marker` (the work was done).
+#[cfg(feature = "mpi")]
+fn alone_and_on(
+    n: usize,
+    args: impl Fn(&PathBuf) -> Vec<String>,
+    (one, many): (PathBuf, PathBuf),
+    code: i32,
+    marker: &str,
+) {
+    let (a1, an) = (args(&one), args(&many));
+    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
+    let b = mpirun(n, &an.iter().map(String::as_str).collect::<Vec<_>>());
+    for o in [&a, &b] {
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let written = std::fs::read(&one).unwrap();
+    assert!(
+        String::from_utf8_lossy(&written).contains(marker),
+        "{marker}"
+    );
+    assert!(
+        written == std::fs::read(&many).unwrap(),
+        "the outputs differ"
+    );
+    assert_eq!(a.stdout, b.stdout, "one summary, printed by rank 0 only");
+}
+
 #[cfg(feature = "mpi")]
 #[test]
 fn two_processes_certify_to_the_same_report_as_one() {
-    let (one, two) = (scratch("one.json"), scratch("two.json"));
-    let a = alone(&["run", "--no-progress", "--json", one.to_str().unwrap()]);
-    let b = mpirun(
-        2,
-        &["run", "--no-progress", "--json", two.to_str().unwrap()],
-    );
-    assert_eq!(a.status.code(), Some(0));
-    assert_eq!(
-        b.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&b.stderr)
-    );
-    let report = std::fs::read(&one).unwrap();
-    assert!(
-        String::from_utf8_lossy(&report).contains("max_utilisation"),
-        "mechanics ran"
-    );
-    assert!(report == std::fs::read(&two).unwrap(), "the reports differ");
-    assert_eq!(a.stdout, b.stdout, "one summary, printed by rank 0 only");
+    let run = |out: &PathBuf| {
+        vec![
+            "run".to_string(),
+            "--no-progress".into(),
+            format!("--json={}", out.display()),
+        ]
+    };
+    let files = (scratch("one.json"), scratch("two.json"));
+    alone_and_on(2, run, files, 0, "max_utilisation");
 }
 
 #[cfg(feature = "mpi")]
@@ -83,7 +106,6 @@ fn three_processes_certify_an_overloaded_schedule_to_the_same_report_as_one() {
         ),
     )
     .unwrap();
-    let (one, three) = (scratch("p2b9-1.json"), scratch("p2b9-3.json"));
     let run = |out: &PathBuf| {
         vec![
             "run".to_string(),
@@ -92,37 +114,13 @@ fn three_processes_certify_an_overloaded_schedule_to_the_same_report_as_one() {
             format!("--json={}", out.display()),
         ]
     };
-    let (a1, a3) = (run(&one), run(&three));
-    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
-    let b = mpirun(3, &a3.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(
-        a.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&a.stderr)
-    );
-    assert_eq!(
-        b.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&b.stderr)
-    );
-    let report = std::fs::read(&one).unwrap();
-    assert!(
-        String::from_utf8_lossy(&report).contains("\"overload\""),
-        "violations were found"
-    );
-    assert!(
-        report == std::fs::read(&three).unwrap(),
-        "the reports differ"
-    );
-    assert_eq!(a.stdout, b.stdout);
+    let files = (scratch("p2b9-1.json"), scratch("p2b9-3.json"));
+    alone_and_on(3, run, files, 1, "\"overload\"");
 }
 
 #[cfg(feature = "mpi")]
 #[test]
 fn two_processes_study_the_same_branch_lengths_as_one() {
-    let (one, two) = (scratch("b1.json"), scratch("b2.json"));
     let args = |p: &PathBuf| {
         vec![
             "b-study".to_string(),
@@ -134,18 +132,8 @@ fn two_processes_study_the_same_branch_lengths_as_one() {
             format!("--json={}", p.display()),
         ]
     };
-    let a1 = args(&one);
-    let a2 = args(&two);
-    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
-    let b = mpirun(2, &a2.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(
-        b.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&b.stderr)
-    );
-    assert_eq!(a.stdout, b.stdout);
-    assert!(std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap());
+    let files = (scratch("b1.json"), scratch("b2.json"));
+    alone_and_on(2, args, files, 0, "\"rows\"");
 }
 
 #[cfg(feature = "mpi")]
@@ -176,7 +164,6 @@ fn three_processes_share_the_ranges_of_one_branch_length() {
     // One b, more processes than b values: the processes share its ranges
     // of steps (the 2-pyramid at b = 9 is overloaded from step 84 on, so
     // limit analyses and critical steps travel between ranks).
-    let (one, three) = (scratch("b9-1.json"), scratch("b9-3.json"));
     let args = |p: &PathBuf| {
         vec![
             "b-study".to_string(),
@@ -188,26 +175,8 @@ fn three_processes_share_the_ranges_of_one_branch_length() {
             format!("--json={}", p.display()),
         ]
     };
-    let (a1, a3) = (args(&one), args(&three));
-    let a = alone(&a1.iter().map(String::as_str).collect::<Vec<_>>());
-    let b = mpirun(3, &a3.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(a.status.code(), Some(0));
-    assert_eq!(
-        b.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&b.stderr)
-    );
-    let study = std::fs::read(&one).unwrap();
-    assert!(
-        String::from_utf8_lossy(&study).contains("\"limit_analyses\""),
-        "the rows were studied"
-    );
-    assert!(
-        study == std::fs::read(&three).unwrap(),
-        "the studies differ"
-    );
-    assert_eq!(a.stdout, b.stdout);
+    let files = (scratch("b9-1.json"), scratch("b9-3.json"));
+    alone_and_on(3, args, files, 0, "\"limit_analyses\"");
 }
 
 #[cfg(not(feature = "mpi"))]
