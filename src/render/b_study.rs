@@ -14,8 +14,10 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
         let root = SvgCanvas::with_string(svg, (1200, 500)).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
         let (left, right) = root.split_horizontally(600);
-        let bmax = study.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 0.5;
-        let bmin = study.rows.iter().map(|r| r.b).min().unwrap_or(1) as f64 - 0.5;
+        // One b more each side than studied: a single b is a point, not a
+        // range, and its markers would sit on the frame.
+        let bmax = study.rows.iter().map(|r| r.b).max().unwrap_or(1) as f64 + 1.0;
+        let bmin = study.rows.iter().map(|r| r.b).min().unwrap_or(1) as f64 - 1.0;
         let umax = study
             .rows
             .iter()
@@ -63,10 +65,17 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
             .iter()
             .map(|r| (r.b as f64, r.closed_utilisation.min(umax)))
             .collect();
-        c.draw_series(LineSeries::new(closed, RED.stroke_width(1)))
+        c.draw_series(LineSeries::new(closed.clone(), RED.stroke_width(1)))
             .map_err(draw_err)?
             .label("closed form: branch of b (b − 1 modules + agent)")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RED.stroke_width(1)));
+        // Marked at each b, so that a study of one b shows its closed form.
+        c.draw_series(
+            closed
+                .iter()
+                .map(|&p| Cross::new(p, 5, RED.stroke_width(2))),
+        )
+        .map_err(draw_err)?;
         crate::render::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
 
         let pmax = study
@@ -141,12 +150,21 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
                     (r.b as f64, (p / 1e3).max(0.1))
                 })
                 .collect();
-            c.draw_series(DashedLineSeries::new(closed, 6, 4, colour.stroke_width(1)))
-                .map_err(draw_err)?
-                .label(format!("{name}, closed form"))
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(1))
-                });
+            c.draw_series(DashedLineSeries::new(
+                closed.clone(),
+                6,
+                4,
+                colour.stroke_width(1),
+            ))
+            .map_err(draw_err)?
+            .label(format!("{name}, closed form"))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(1)));
+            c.draw_series(
+                closed
+                    .iter()
+                    .map(|&p| Cross::new(p, 5, colour.stroke_width(2))),
+            )
+            .map_err(draw_err)?;
         }
         crate::render::legend(&mut c, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(draw_err)?;

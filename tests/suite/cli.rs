@@ -407,6 +407,31 @@ fn assert_png(path: &Path) {
     assert_eq!(&bytes[1..4], b"PNG", "{}", path.display());
 }
 
+/// A study of one b is a point per curve: its plot marks the closed forms
+/// at that b (a cross each: two strokes in the closed form's colour), not
+/// only the studied figures, and the range leaves room on either side.
+#[cfg(feature = "render")]
+#[test]
+fn a_b_study_of_one_b_plots_its_closed_forms() {
+    let svg = scratch("b-one.svg");
+    succeed(
+        bin()
+            .arg("b-study")
+            .args(["--family", "branch", "--b-min", "3", "--b-max", "3"])
+            .arg("--plot")
+            .arg(&svg),
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    // Red: the utilisation's closed form; blue and green: the pressures'.
+    for colour in ["#FF0000", "#0000FF", "#00FF00"] {
+        let crosses = text
+            .lines()
+            .filter(|l| l.starts_with("<line") && l.contains(&format!("stroke=\"{colour}\"")))
+            .count();
+        assert!(crosses >= 2, "{colour}: {crosses} strokes");
+    }
+}
+
 #[test]
 fn b_study_of_the_pyramid_family_writes_a_table_a_plot_and_json() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
