@@ -100,9 +100,8 @@ pub struct Analysis {
     pub load_factor_lower: Option<f64>,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
-    /// Intervals between two samples whose poses between samples were
-    /// judged one by one ([`Structure::between`]); the others were cleared
-    /// by a bound of the whole interval.
+    /// Poses between samples judged one by one ([`Structure::between`]):
+    /// those of the intervals a bound of the whole interval did not clear.
     pub between_poses: usize,
     /// Components judged at the samples alone: their loads were solved
     /// pose by pose (more movers than superposition pays for), or their
@@ -375,12 +374,15 @@ fn lowest(x: f64, y: f64) -> f64 {
 fn mover_moment(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
     let hg = &s.hanging[h];
     let p = s.bodies[hg.pivot].centre;
-    let g = s.gravity;
-    let r = match pose {
-        Some(k) => s.mover_point(h, k) - p,
-        None => worst_lever(hg.path.iter().map(|c| *c - p), g),
-    };
-    r.cross(g)
+    match pose {
+        Some(k) => moment_at(s, h, s.mover_point(h, k)),
+        None => worst_lever(hg.path.iter().map(|c| *c - p), s.gravity).cross(s.gravity),
+    }
+}
+
+/// Mover `h`'s moment on its pivot (units `W·d`) with its centre at `c`.
+fn moment_at(s: &Structure, h: usize, c: DVec3) -> DVec3 {
+    (c - s.bodies[s.hanging[h].pivot].centre).cross(s.gravity)
 }
 
 /// The offset with the largest horizontal lever (component across gravity);
@@ -720,21 +722,23 @@ impl Analyzer {
         for (j, &li) in active.iter().enumerate() {
             slot[li] = j;
         }
+        // A pose's interface forces superposed from the unit solutions.
+        let superposed = |pose: Option<usize>, sf: &mut Vec<Vec6>| {
+            sf.clone_from(&sf_reference);
+            for (h, e, reference, sf_b) in &basis {
+                let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
+                if c != 0.0 {
+                    sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
+                }
+            }
+        };
         // Each pose's interface forces, one at a time (never all stored).
         screen.links = vec![LinkResult::default(); links.len()];
         let mut sf: Vec<Vec6> = Vec::new();
         for (i, pose) in poses.into_iter().enumerate() {
             match pose {
                 None => sf.clone_from(&sf_reference),
-                Some(_) if superpose => {
-                    sf.clone_from(&sf_reference);
-                    for (h, e, reference, sf_b) in &basis {
-                        let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
-                        if c != 0.0 {
-                            sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
-                        }
-                    }
-                }
+                Some(_) if superpose => superposed(pose, &mut sf),
                 Some(_) => sf = sf_of(&solutions[i]),
             }
             let sf_link = |li: usize| &sf[slot[li]];
@@ -760,11 +764,7 @@ impl Analyzer {
                 if !self.interval_clear(s, &active, &sf_reference, &basis, i) {
                     for v in i * per_interval..(i + 1) * per_interval {
                         let pose = Some(n_samples + v);
-                        sf.clone_from(&sf_reference);
-                        for (h, e, reference, sf_b) in &basis {
-                            let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
-                            sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
-                        }
+                        superposed(pose, &mut sf);
                         let sf_link = |li: usize| &sf[slot[li]];
                         let mut scratch = vec![LinkResult::default(); links.len()];
                         let judged = self.judge_pose(s, links, &st, &sf_link, true, &mut scratch);
@@ -1002,8 +1002,7 @@ impl Analyzer {
         let mut share = vec![[zero.clone(), zero]; groups];
         for (h, e, reference, sf_b) in basis {
             let hg = &s.hanging[*h];
-            let p = s.bodies[hg.pivot].centre;
-            let m = |c: DVec3| (c - p).cross(s.gravity);
+            let m = |c: DVec3| moment_at(s, *h, c);
             let m_i = m(hg.path[i]);
             let c = (m_i - *reference).dot(*e);
             let c1 = (m(hg.path[i + 1]) - m_i).dot(*e);
