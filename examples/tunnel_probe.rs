@@ -13,13 +13,17 @@
 //! with the certifier's own step rules (`atom_search::Scene::step`: arm
 //! kinematics, exact moving-box collisions, connectivity). Every body and
 //! arm must stay inside the union of the start's and the goal's bounding
-//! boxes (the in-place claim); `--loose` widens it by one atom all round.
+//! boxes (the in-place claim); `--loose` widens it by one atom all round,
+//! `--corner` adds the meta cell between the two legs (inside the robot's
+//! bounding box wherever a comb tunnels), `--with-l` adds the meta-module
+//! the turn hangs on, opposite the exit (the frame).
 //!
 //! ```sh
 //! cargo run --release --example tunnel_probe                  # 2D slice, in place
 //! cargo run --release --example tunnel_probe -- --pairs
 //! cargo run --release --example tunnel_probe -- --loose
 //! cargo run --release --example tunnel_probe -- --three-d --max-states 3000000
+//! cargo run --release --example tunnel_probe -- --corner --with-l
 //! ```
 
 use reconfcheck::geometry::atom::contact_face;
@@ -31,6 +35,8 @@ use std::collections::{BTreeSet, BinaryHeap};
 
 struct Setup {
     loose: bool,
+    corner: bool,
+    with_l: bool,
     pairs: bool,
     zmax: i32,
     max_states: usize,
@@ -42,7 +48,11 @@ impl Setup {
         let in_box = |x0: i32, x1: i32, y0: i32, y1: i32| {
             (x0 - m..=x1 + m).contains(&c.x) && (y0 - m..=y1 + m).contains(&c.y)
         };
-        (0..=self.zmax).contains(&c.z) && (in_box(0, 3, 0, 1) || in_box(0, 1, 0, 3))
+        (0..=self.zmax).contains(&c.z)
+            && ((self.with_l && in_box(-2, -1, 0, 1))
+                || in_box(0, 3, 0, 1)
+                || in_box(0, 1, 0, 3)
+                || (self.corner && in_box(2, 3, 2, 3)))
     }
 }
 
@@ -74,6 +84,8 @@ fn main() {
         .map_or(3_000_000, |v| v.parse().expect("--max-states N"));
     let set = Setup {
         loose: has("--loose"),
+        corner: has("--corner"),
+        with_l: has("--with-l"),
         pairs: has("--pairs"),
         zmax: has("--three-d") as i32,
         max_states,
@@ -88,11 +100,19 @@ fn main() {
         [(0, 0), (1, 0), (0, 1), (1, 1)],
         [(2, 0), (3, 0), (2, 1), (3, 1)],
     );
-    let pos: Vec<Cell> = layers(&b).into_iter().chain(layers(&a)).collect();
+    let l = [(-2, 0), (-1, 0), (-2, 1), (-1, 1)];
+    let with_l = set.with_l;
+    let mut pos: Vec<Cell> = layers(&b).into_iter().chain(layers(&a)).collect();
+    if with_l {
+        pos.extend(layers(&l));
+    }
     let ext = vec![[false; 6]; pos.len()];
     let bonds = Scene::all_bonds(&pos, &ext);
     let start = canonical(&Scene { pos, ext, bonds });
-    let goal: BTreeSet<Cell> = layers(&b).into_iter().chain(layers(&e)).collect();
+    let mut goal: BTreeSet<Cell> = layers(&b).into_iter().chain(layers(&e)).collect();
+    if with_l {
+        goal.extend(layers(&l));
+    }
     let mut faces = vec![Face::PosX, Face::NegX, Face::PosY, Face::NegY];
     if set.zmax > 0 {
         faces.extend([Face::PosZ, Face::NegZ]);
@@ -180,7 +200,7 @@ fn main() {
         }
         // The frame: the atom on B's corner cell (always a goal cell).
         let anchors: Vec<usize> = (0..n)
-            .find(|&i| s.pos[i] == Cell::new(0, 0, 0))
+            .find(|&i| s.pos[i] == Cell::new(if with_l { -2 } else { 0 }, 0, 0))
             .into_iter()
             .collect();
         let anchors = if anchors.is_empty() { vec![0] } else { anchors };

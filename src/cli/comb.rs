@@ -4,6 +4,7 @@
 
 use reconfcheck::algorithms::atom_moves::derive_slide;
 use reconfcheck::error::{Error, write_file};
+use reconfcheck::geometry::atom_expand::tunnel_library;
 use reconfcheck::geometry::atom_search::Carry;
 use reconfcheck::lattice::AtomRest;
 use reconfcheck::study::comb as study;
@@ -54,7 +55,18 @@ pub fn run(a: Args) -> Result<u8, Error> {
             }
         }
     }
-    println!("k-TUNNEL: not derived (see docs/atoms.md)");
+    match tunnel_library(AtomRest::Contracted) {
+        Some(t) => println!(
+            "1-TUNNEL, contracted (a leaf through one turn, legs of one meta-module; paper: O(1)): {} steps, {} ops, {} states",
+            t.steps.len(),
+            t.steps.iter().map(Vec::len).sum::<usize>(),
+            t.found.states_explored
+        ),
+        None => println!("1-TUNNEL, contracted: not found"),
+    }
+    println!(
+        "k-TUNNEL for k > 1, with longer legs, and in the expanded model: not derived (see docs/atoms.md)"
+    );
     let mut all = Vec::new();
     // The expanded model has no derived SLIDE (docs/atoms.md).
     for rest in [AtomRest::Contracted] {

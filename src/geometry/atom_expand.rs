@@ -12,12 +12,22 @@
 //!   they are attached to the slider's).
 //! * `attach`, `detach`: the four pairs of touching atoms of two
 //!   neighbouring meta-modules, in one step.
-//! * `tunnel`: refused — this build derives no k-TUNNEL (see
-//!   `docs/atoms.md`), and a tunnel is not taken on trust.
+//! * `tunnel` along `[A, B, exit]`: the derived 1-TUNNEL (contracted
+//!   model; a leaf A through the turn B, held by one meta-module opposite
+//!   the exit, the exit and the corner between the legs free), turned like
+//!   a slide and run in lockstep with the step's slides. Any other tunnel
+//!   (longer paths, legs, more turns, the expanded model) is refused: it
+//!   has no derived atom sequence, and a tunnel is not taken on trust.
 //!
-//! Atom `8·id + i + 2j + 4k` is atom `(i, j, k)` of meta-module `id`.
+//! Atom `8·id + i + 2j + 4k` is atom `(i, j, k)` of meta-module `id` at the
+//! start. The derived 1-TUNNEL exchanges atoms between A and B (no
+//! sequence without exchange was found), so the expansion keeps each
+//! meta-module's atoms: after a tunnel, a meta-module is the atoms in its
+//! cell.
 
-use super::atom_search::{Carry, Found, Op, Problem, lift, rest_spacing, slide_problem};
+use super::atom_search::{
+    Carry, Found, Legs, Op, Problem, Scene, lift, rest_spacing, slide_problem, tunnel_problem,
+};
 use crate::error::InputError;
 use crate::lattice::config::ModuleId;
 use crate::lattice::{AtomRest, Cell, Face};
@@ -76,6 +86,46 @@ fn library(
         })
     })
     .as_ref()
+}
+
+/// The derived 1-TUNNEL ([`tunnel_problem`] without legs), lifted to 3D.
+pub struct TunnelLibrary {
+    pub problem: Problem,
+    pub found: Found,
+    /// The 2D slice at the end of the move (where each atom ends up).
+    pub end: Scene,
+    /// The lifted steps (atom numbering as in [`SlideLibrary::steps`]).
+    pub steps: Vec<Vec<Op>>,
+}
+
+/// Bound of the 1-TUNNEL search (states); the contracted model's move is
+/// found after about 220,000.
+pub const TUNNEL_MAX_STATES: usize = 3_000_000;
+
+/// The 1-TUNNEL of the contracted model, searched once per process; `None`
+/// for the expanded model (not derived: see `docs/atoms.md`).
+pub fn tunnel_library(rest: AtomRest) -> Option<&'static TunnelLibrary> {
+    static CONTRACTED: OnceLock<Option<TunnelLibrary>> = OnceLock::new();
+    if rest != AtomRest::Contracted {
+        return None;
+    }
+    CONTRACTED
+        .get_or_init(|| {
+            let (problem, _) = tunnel_problem(rest, Legs::ALL[0]);
+            let found = problem.solve_guided(2, TUNNEL_MAX_STATES)?;
+            let mut end = problem.start.clone();
+            for st in &found.steps {
+                end = end.step(st, &problem.anchors, problem.eps)?;
+            }
+            let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+            Some(TunnelLibrary {
+                problem,
+                found,
+                end,
+                steps,
+            })
+        })
+        .as_ref()
 }
 
 /// A signed axis permutation (a lattice symmetry, mirror images included).
@@ -139,8 +189,9 @@ fn atoms_of(id: ModuleId, c: Cell, sp: i32) -> impl Iterator<Item = ModuleSpec> 
     })
 }
 
-/// The touching atom pairs of meta-modules `a` at `ca` and `b` at `cb`.
-fn face_pairs(a: ModuleId, ca: Cell, b: ModuleId, cb: Cell) -> Option<Vec<(ModuleId, ModuleId)>> {
+/// The touching atom pairs of meta-modules at `ca` and `cb`, as local
+/// atom indices (`i + 2j + 4k`) of the first and of the second.
+fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
     let d = cb - ca;
     if d.l1() != 1 {
         return None;
@@ -157,13 +208,107 @@ fn face_pairs(a: ModuleId, ca: Cell, b: ModuleId, cb: Cell) -> Option<Vec<(Modul
     Some(
         (0..8u32)
             .filter(|l| (l & bit != 0) == (sign > 0))
-            .map(|l| (a * 8 + l, b * 8 + (l ^ bit)))
+            .map(|l| (l as usize, (l ^ bit) as usize))
             .collect(),
     )
 }
 
+/// A 1-TUNNEL placed in the robot: the turn B, the static neighbour L
+/// opposite the exit, the exit cell, and the symmetry's canonical −x and −y.
+struct PlacedTunnel {
+    b: ModuleId,
+    l: ModuleId,
+    exit: Cell,
+    d: Cell,
+    w: Cell,
+}
+
+/// Checks that a `tunnel` event is the derived 1-TUNNEL: a path `[A, B,
+/// exit]` with one turn, A a leaf on B, B held only by A and by L on the
+/// side opposite the exit, the exit and the corner between the two legs
+/// free. Anything else is refused with the reason.
+fn one_tunnel(
+    here: Cell,
+    path: &[Cell],
+    by_cell: &FxHashMap<Cell, ModuleId>,
+    rest: AtomRest,
+) -> Result<PlacedTunnel, String> {
+    let [a, b, c] = path else {
+        return Err(format!(
+            "only 1-TUNNEL with legs of one meta-module is derived (a path of 3 cells), not a path of {} cells",
+            path.len()
+        ));
+    };
+    if *a != here {
+        return Err(format!(
+            "the tunnel starts at {a}, but the meta-module is at {here}"
+        ));
+    }
+    let (up, out) = (*a - *b, *c - *b);
+    if up.l1() != 1 || out.l1() != 1 || up.x * out.x + up.y * out.y + up.z * out.z != 0 {
+        return Err(format!(
+            "a 1-TUNNEL path turns once between neighbouring cells; {a}, {b}, {c} do not"
+        ));
+    }
+    tunnel_library(rest).ok_or_else(|| {
+        format!(
+            "no atom sequence for 1-TUNNEL was derived in the {} model",
+            format!("{rest:?}").to_lowercase()
+        )
+    })?;
+    let turn_id = *by_cell
+        .get(b)
+        .ok_or_else(|| format!("the tunnel turns at {b}, where there is no meta-module"))?;
+    let behind = *b - out;
+    let l = *by_cell.get(&behind).ok_or_else(|| {
+        format!("the turn {b} must hang on a meta-module at {behind}, opposite the exit")
+    })?;
+    for (cell, what) in [(*c, "the exit"), (*c + up, "the corner between the legs")] {
+        if let Some(o) = by_cell.get(&cell) {
+            return Err(format!("{what} {cell} is taken by meta-module {o}"));
+        }
+    }
+    let dirs = Face::ALL.map(|f| f.dir());
+    for n in dirs.iter().map(|&v| *a + v).filter(|n| n != b) {
+        if let Some(o) = by_cell.get(&n) {
+            return Err(format!(
+                "the tunnelling meta-module must be a leaf on the turn; meta-module {o} at {n} touches it"
+            ));
+        }
+    }
+    for n in dirs
+        .iter()
+        .map(|&v| *b + v)
+        .filter(|n| n != a && *n != behind)
+    {
+        if let Some(o) = by_cell.get(&n) {
+            return Err(format!(
+                "the turn {b} may touch only the tunnelling meta-module and the one opposite the exit; meta-module {o} at {n} touches it"
+            ));
+        }
+    }
+    Ok(PlacedTunnel {
+        b: turn_id,
+        l,
+        exit: *c,
+        d: Cell::ZERO - out,
+        w: Cell::ZERO - up,
+    })
+}
+
 /// Expands a `meta_modules` schedule into an `atoms` schedule.
 pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
+    Ok(expand_tracked(s, rest)?.0)
+}
+
+/// Each meta-module's atoms by local index (`i + 2j + 4k`) at the end.
+type Owners = FxHashMap<ModuleId, [ModuleId; 8]>;
+
+/// [`expand`], with each meta-module's atoms and cell at the end.
+fn expand_tracked(
+    s: &Schedule,
+    rest: AtomRest,
+) -> Result<(Schedule, Owners, FxHashMap<ModuleId, Cell>), InputError> {
     let sp = rest_spacing(rest);
     let mut out = Schedule::new(s.lattice, s.spacing);
     out.atoms = Some(rest);
@@ -172,6 +317,9 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
     out.meta
         .insert("expanded_from".into(), "meta_modules".into());
     let mut at: FxHashMap<ModuleId, Cell> = FxHashMap::default();
+    // The atoms of each meta-module by local index: `8·id + l` at the
+    // start; a tunnel exchanges atoms between the meta-modules it involves.
+    let mut owner: FxHashMap<ModuleId, [ModuleId; 8]> = FxHashMap::default();
     let mut by_cell: FxHashMap<Cell, ModuleId> = FxHashMap::default();
     for m in &s.modules {
         if m.id > u32::MAX / 8 - 1 {
@@ -187,6 +335,7 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
         if by_cell.insert(m.cell, m.id).is_some() {
             return Err(InputError::new(format!("two meta-modules at {}", m.cell)).for_module(m.id));
         }
+        owner.insert(m.id, std::array::from_fn(|l| m.id * 8 + l as ModuleId));
         out.modules.extend(atoms_of(m.id, m.cell, sp).map(|mut a| {
             a.fixed = m.fixed;
             a
@@ -199,6 +348,7 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
         let mut moved: Vec<(ModuleId, Cell)> = Vec::new();
         let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
             FxHashMap::default();
+        let mut retag: Vec<(ModuleId, [ModuleId; 8], ModuleId, [ModuleId; 8])> = Vec::new();
         for e in &step.events {
             let id = e.module();
             let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
@@ -210,10 +360,11 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                     let there = *at
                         .get(other)
                         .ok_or_else(|| err(format!("meta-module {other} is not in the robot")))?;
-                    let pairs = face_pairs(id, here, *other, there).ok_or_else(|| {
+                    let pairs = face_pairs(here, there).ok_or_else(|| {
                         err(format!("meta-modules {id} and {other} are not neighbours"))
                     })?;
-                    for (a, b) in pairs {
+                    for (la, lb) in pairs {
+                        let (a, b) = (owner[&id][la], owner[other][lb]);
                         latch.push(if matches!(e, Event::Attach { .. }) {
                             Event::Attach {
                                 module: a,
@@ -257,10 +408,46 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                     })?;
                     walls.entry(id).or_default().push((d, w, *b, c));
                 }
-                Event::Tunnel { .. } => {
-                    return Err(err(
-                        "k-TUNNEL has no atom sequence in this build, and a tunnel is not certified on trust".into(),
-                    ));
+                Event::Tunnel { path, .. } => {
+                    let t = one_tunnel(here, path, &by_cell, rest).map_err(err)?;
+                    let lib = tunnel_library(rest).expect("one_tunnel found the library");
+                    let turn = Turn::new(t.d, t.w);
+                    let ids = [t.l, t.b, id];
+                    let local = |q: usize| -> ((i32, i32), usize) {
+                        let a2 = q / 2;
+                        ([(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4], a2 / 4)
+                    };
+                    let atom = |q: usize| -> ModuleId {
+                        let ((i, j), meta) = local(q);
+                        owner[&ids[meta]][turn.local(i, j, (q % 2) as i32) as usize]
+                    };
+                    slides.push(
+                        lib.steps
+                            .iter()
+                            .map(|st| {
+                                st.iter()
+                                    .map(|op| op.event(atom, |f| turn.face(f)))
+                                    .collect()
+                            })
+                            .collect(),
+                    );
+                    // Where each atom of B and A ends: B's cell keeps B, the
+                    // exit cell is A's.
+                    let mut ob = owner[&t.b];
+                    let mut oa = owner[&id];
+                    for q in 8..24 {
+                        let e = lib.end.pos[q / 2];
+                        let k = (q % 2) as i32;
+                        let to = turn.local(e.x.rem_euclid(2), e.y.rem_euclid(2), k) as usize;
+                        let a = atom(q);
+                        if e.x.div_euclid(2) == 0 {
+                            ob[to] = a;
+                        } else {
+                            oa[to] = a;
+                        }
+                    }
+                    retag.push((t.b, ob, id, oa));
+                    moved.push((id, t.exit));
                 }
                 _ => {
                     return Err(err(
@@ -298,7 +485,10 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                 let a2 = q / 2;
                 let meta = a2 / 4;
                 let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
-                ids[meta] * 8 + turn.local(i, j, (q % 2) as i32)
+                let m = ids[meta];
+                let l = turn.local(i, j, (q % 2) as i32);
+                // F and H of the double slide's scene (ids 0) never act.
+                owner.get(&m).map_or(m * 8 + l, |o| o[l as usize])
             };
             let steps: Vec<Vec<Event>> = lib
                 .steps
@@ -324,6 +514,10 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
                 .collect();
             out.steps.push(Step { events });
         }
+        for (b, ob, a, oa) in retag {
+            owner.insert(b, ob);
+            owner.insert(a, oa);
+        }
         for &(id, _) in &moved {
             by_cell.remove(&at[&id]);
         }
@@ -338,7 +532,7 @@ pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
             at.insert(id, to);
         }
     }
-    Ok(out)
+    Ok((out, owner, at))
 }
 
 #[cfg(test)]
@@ -371,10 +565,84 @@ mod tests {
         }
     }
 
+    /// Replays an atom schedule's events with the search's step rules.
+    fn replay(atoms: &Schedule) -> FxHashMap<ModuleId, Cell> {
+        use super::super::atom_search::Scene;
+        let ids: Vec<ModuleId> = atoms.modules.iter().map(|m| m.id).collect();
+        let ix = |m: ModuleId| ids.iter().position(|&i| i == m).unwrap();
+        let pos: Vec<Cell> = atoms.modules.iter().map(|m| m.cell).collect();
+        let ext = vec![[false; 6]; pos.len()];
+        let mut scene = Scene {
+            bonds: Scene::all_bonds(&pos, &ext),
+            pos,
+            ext,
+        };
+        let anchors: Vec<usize> = (0..ids.len()).filter(|&a| atoms.modules[a].fixed).collect();
+        for st in &atoms.steps {
+            let ops: Vec<Op> = st
+                .events
+                .iter()
+                .map(|e| match *e {
+                    Event::Expand { module, face } => Op::Expand(ix(module), face),
+                    Event::Contract { module, face } => Op::Contract(ix(module), face),
+                    Event::Attach { module, other } => Op::Attach(ix(module), ix(other)),
+                    Event::Detach { module, other } => Op::Detach(ix(module), ix(other)),
+                    _ => unreachable!(),
+                })
+                .collect();
+            scene = scene.step(&ops, &anchors, 1e-6).expect("a valid step");
+        }
+        ids.iter().copied().zip(scene.pos).collect()
+    }
+
+    #[test]
+    fn after_a_tunnel_each_meta_module_is_the_atoms_in_its_cell() {
+        // L2 (fixed), L, the turn B, the leaf A on B, G on L2; A tunnels
+        // through B to the exit (1, 0, 0), turned so that the slice is
+        // lifted along y.
+        let m = |id: ModuleId, c: [i32; 3]| ModuleSpec {
+            id,
+            cell: Cell::new(c[0], c[1], c[2]),
+            fixed: id == 0,
+        };
+        let mut s = Schedule::new(
+            crate::lattice::LatticeKind::Cubic,
+            crate::schedule::Length::mm(60.0),
+        );
+        s.meta_modules = Some(AtomRest::Contracted);
+        s.modules = vec![
+            m(0, [-2, 0, 0]),
+            m(1, [-1, 0, 0]),
+            m(2, [0, 0, 0]),
+            m(3, [0, 0, 1]),
+            m(4, [-2, 0, 1]),
+        ];
+        s.steps = vec![Step {
+            events: vec![Event::Tunnel {
+                module: 3,
+                path: vec![Cell::new(0, 0, 1), Cell::new(0, 0, 0), Cell::new(1, 0, 0)],
+            }],
+        }];
+        let (atoms, owners, at) = expand_tracked(&s, AtomRest::Contracted).unwrap();
+        assert_eq!(at[&3], Cell::new(1, 0, 0));
+        assert_eq!(at[&2], Cell::new(0, 0, 0));
+        let end = replay(&atoms);
+        let mut exchanged = 0;
+        for (id, own) in &owners {
+            for (l, a) in own.iter().enumerate() {
+                let want = atoms_of(*id, at[id], 1).nth(l).unwrap().cell;
+                assert_eq!(end[a], want, "meta-module {id}, local atom {l}");
+                exchanged += (*a / 8 != *id) as usize;
+            }
+        }
+        // The derived move exchanges atoms between A and B (docs/atoms.md).
+        assert!(exchanged > 0);
+    }
+
     #[test]
     fn neighbouring_meta_modules_touch_through_four_atom_pairs() {
-        let p = face_pairs(0, Cell::new(0, 0, 0), 1, Cell::new(1, 0, 0)).unwrap();
-        assert_eq!(p, vec![(1, 8), (3, 10), (5, 12), (7, 14)]);
-        assert!(face_pairs(0, Cell::new(0, 0, 0), 1, Cell::new(1, 1, 0)).is_none());
+        let p = face_pairs(Cell::new(0, 0, 0), Cell::new(1, 0, 0)).unwrap();
+        assert_eq!(p, vec![(1, 0), (3, 2), (5, 4), (7, 6)]);
+        assert!(face_pairs(Cell::new(0, 0, 0), Cell::new(1, 1, 0)).is_none());
     }
 }

@@ -85,6 +85,28 @@ impl Scene {
         out
     }
 
+    /// The scene with its atoms sorted by position and faces, and for each
+    /// atom of it the index it had here: the form in which permutations of
+    /// identical atoms are one state.
+    pub fn canonical(&self) -> (Scene, Vec<usize>) {
+        let mut idx: Vec<usize> = (0..self.pos.len()).collect();
+        idx.sort_by_key(|&i| ((self.pos[i].x, self.pos[i].y, self.pos[i].z), self.ext[i]));
+        let mut inv = vec![0; idx.len()];
+        for (k, &i) in idx.iter().enumerate() {
+            inv[i] = k;
+        }
+        let scene = Scene {
+            pos: idx.iter().map(|&i| self.pos[i]).collect(),
+            ext: idx.iter().map(|&i| self.ext[i]).collect(),
+            bonds: self
+                .bonds
+                .iter()
+                .map(|&(a, b)| pair(inv[a], inv[b]))
+                .collect(),
+        };
+        (scene, idx)
+    }
+
     fn bond_list(&self) -> Vec<Bond> {
         self.bonds
             .iter()
@@ -211,6 +233,14 @@ pub struct Problem {
     /// Search no deeper (atom operations).
     pub max_ops: usize,
     pub eps: f64,
+    /// Where bodies and arms may be (atom cells of the 2D slice), when the
+    /// move must stay inside given room (a k-TUNNEL's in-place claim).
+    pub room: Option<FxHashSet<Cell>>,
+    /// Atoms are interchangeable: a state is its occupied cells, faces and
+    /// bonds, whichever atom is where (`solve_guided` only). The found
+    /// operations name the start's atoms; the goal is met by any
+    /// assignment of atoms to its cells.
+    pub exchange: bool,
 }
 
 /// A found sequence: single operations in order, and packed into steps.
@@ -259,6 +289,21 @@ impl Problem {
     }
 
     fn within_reach(&self, s: &Scene) -> bool {
+        if let Some(room) = &self.room {
+            let inside = s.pos.iter().zip(&s.ext).all(|(p, e)| {
+                room.contains(p)
+                    && Face::ALL
+                        .iter()
+                        .all(|f| !e[f.index()] || room.contains(&(*p + f.dir())))
+            });
+            if !inside {
+                return false;
+            }
+        }
+        if self.exchange {
+            // Atom indices name places in a canonical order, not atoms.
+            return true;
+        }
         let axis = |c: Cell, i: usize| [c.x, c.y, c.z][i];
         if self
             .pinned
@@ -311,6 +356,120 @@ impl Problem {
             }
         }
         None
+    }
+
+    /// Best-first search, for scenes too large to search breadth first:
+    /// states in order of operations so far plus `weight` times the atoms'
+    /// L1 distance to their goal positions. Finds *a* sequence, not
+    /// necessarily the shortest; `None` when none exists within the reach,
+    /// the room and `max_ops`, or `max_states` are explored first.
+    pub fn solve_guided(&self, weight: usize, max_states: usize) -> Option<Found> {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        let canon = |s: Scene| if self.exchange { s.canonical().0 } else { s };
+        let goal = canon(self.goal.clone());
+        let goal_cells: BTreeSet<Cell> = goal.pos.iter().copied().collect();
+        let h = |s: &Scene| -> usize {
+            if self.exchange {
+                // Each misplaced atom's distance to the nearest free goal cell.
+                let occ: BTreeSet<Cell> = s.pos.iter().copied().collect();
+                let free: Vec<Cell> = goal_cells.difference(&occ).copied().collect();
+                return s
+                    .pos
+                    .iter()
+                    .filter(|c| !goal_cells.contains(c))
+                    .map(|c| free.iter().map(|g| (*g - *c).l1()).min().unwrap_or(0) as usize)
+                    .sum::<usize>()
+                    + s.ext
+                        .iter()
+                        .flatten()
+                        .filter(|&&x| x != goal.ext[0][0])
+                        .count();
+            }
+            s.pos
+                .iter()
+                .zip(&self.goal.pos)
+                .map(|(p, g)| (*p - *g).l1() as usize)
+                .sum::<usize>()
+                + s.ext
+                    .iter()
+                    .zip(&self.goal.ext)
+                    .map(|(e, g)| e.iter().zip(g).filter(|(x, y)| x != y).count())
+                    .sum::<usize>()
+        };
+        let mut parent: FxHashMap<Scene, Option<(usize, Op)>> = FxHashMap::default();
+        let start = canon(self.start.clone());
+        let mut states = vec![start.clone()];
+        parent.insert(start.clone(), None);
+        let mut open = BinaryHeap::from([Reverse((weight * h(&start), 0usize, 0usize))]);
+        let mut back: Vec<Option<(usize, Op)>> = vec![None];
+        while let Some(Reverse((_, depth, id))) = open.pop() {
+            let s = states[id].clone();
+            if s == goal {
+                let mut ops = Vec::new();
+                let mut cur = id;
+                while let Some((prev, op)) = back[cur] {
+                    ops.push(op);
+                    cur = prev;
+                }
+                ops.reverse();
+                if self.exchange {
+                    ops = self.name_atoms(&ops);
+                }
+                let steps = self.pack(&ops);
+                return Some(Found {
+                    ops,
+                    steps,
+                    states_explored: parent.len(),
+                });
+            }
+            if depth >= self.max_ops || parent.len() >= max_states {
+                continue;
+            }
+            for op in self.candidate_ops(&s) {
+                let Some(next) = s.step(&[op], &self.anchors, self.eps) else {
+                    continue;
+                };
+                if !self.within_reach(&next) {
+                    continue;
+                }
+                let next = canon(next);
+                if parent.contains_key(&next) {
+                    continue;
+                }
+                parent.insert(next.clone(), Some((id, op)));
+                open.push(Reverse((
+                    depth + 1 + weight * h(&next),
+                    depth + 1,
+                    states.len(),
+                )));
+                back.push(Some((id, op)));
+                states.push(next);
+            }
+        }
+        None
+    }
+
+    /// Operations found on canonical states, renamed to the start's atoms
+    /// by replaying them (the step rules do not depend on atom order, and
+    /// the anchors stay first in every canonical order).
+    fn name_atoms(&self, canonical_ops: &[Op]) -> Vec<Op> {
+        let mut real = self.start.clone();
+        let mut out = Vec::with_capacity(canonical_ops.len());
+        for &op in canonical_ops {
+            let (_, idx) = real.canonical();
+            let named = match op {
+                Op::Expand(a, f) => Op::Expand(idx[a], f),
+                Op::Contract(a, f) => Op::Contract(idx[a], f),
+                Op::Attach(a, b) => Op::Attach(pair(idx[a], idx[b]).0, pair(idx[a], idx[b]).1),
+                Op::Detach(a, b) => Op::Detach(pair(idx[a], idx[b]).0, pair(idx[a], idx[b]).1),
+            };
+            real = real
+                .step(&[named], &self.anchors, self.eps)
+                .expect("a found operation replays on the start's atoms");
+            out.push(named);
+        }
+        out
     }
 
     /// Packs a sequence into parallel steps greedily (see the module doc).
@@ -477,6 +636,8 @@ pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, 
         reach: 2 * sp + 1,
         max_ops: 60,
         eps: 1e-6,
+        room: None,
+        exchange: false,
     };
     (problem, label)
 }
@@ -571,4 +732,129 @@ pub fn lift(scene: &Scene, steps: &[Vec<Op>], sp: i32) -> (Scene, Vec<Vec<Op>>) 
         })
         .collect();
     (Scene { pos, ext, bonds }, lifted)
+}
+
+/// The legs of a 1-TUNNEL's path that travel with it (seed 004 Fig. 2):
+/// the meta-modules beyond the tunnelling leaf A on the way in, and beyond
+/// the pop-out cell on the way out. Legs are unattached to anything but
+/// the path (the paper's precondition), so a longer leg moves rigidly like
+/// one carried meta-module.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Legs {
+    /// A meta-module D behind A, pushed in with it.
+    pub behind: bool,
+    /// A meta-module E in the pop-out cell, pushed out one cell further.
+    pub ahead: bool,
+}
+
+impl Legs {
+    pub const ALL: [Legs; 4] = [
+        Legs {
+            behind: false,
+            ahead: false,
+        },
+        Legs {
+            behind: true,
+            ahead: false,
+        },
+        Legs {
+            behind: false,
+            ahead: true,
+        },
+        Legs {
+            behind: true,
+            ahead: true,
+        },
+    ];
+
+    pub fn name(self) -> &'static str {
+        match (self.behind, self.ahead) {
+            (false, false) => "alone",
+            (true, false) => "pushing a leg in",
+            (false, true) => "pushing a leg out",
+            (true, true) => "both legs",
+        }
+    }
+}
+
+/// The labelled scene of 1-TUNNEL((x, y + 1), (x + 1, y)) in a 2D slice
+/// (seed 004 Fig. 12): the leaf A at meta cell (0, 1) is pushed into the
+/// turn B (0, 0), whose mass pops out at (1, 0). B hangs on the rest of
+/// the robot through L (−1, 0), opposite the way out (the frame). Atoms
+/// are not exchanged between meta-modules (the paper's implementations
+/// avoid it): A's atoms end where B's were, B's one cell along +x, each
+/// in the same place within its meta-module. Legs: D (0, 2) behind A ends
+/// at (0, 1), E (1, 0) ahead ends at (2, 0); they may move only along
+/// their leg and do not act. Room: the cells of the path, L, and the
+/// corner (1, 1) between the two legs, which is inside the robot's
+/// bounding box whenever the legs are (and empty wherever the combing
+/// tunnels, next to a leaf at the end of a comb's teeth). Only A's and
+/// B's atoms act. Atom order: L, B, A, then D and E. Returns the problem
+/// and each atom's meta-module label.
+pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, Vec<char>) {
+    let sp = rest_spacing(rest);
+    let mut metas: Vec<MetaPlace> = vec![
+        ('L', (-1, 0), (-1, 0)),
+        ('B', (0, 0), (1, 0)),
+        ('A', (0, 1), (0, 0)),
+    ];
+    if legs.behind {
+        metas.push(('D', (0, 2), (0, 1)));
+    }
+    if legs.ahead {
+        metas.push(('E', (1, 0), (2, 0)));
+    }
+    let mut pos = Vec::new();
+    let mut goal_pos = Vec::new();
+    let mut label = Vec::new();
+    let mut room = FxHashSet::default();
+    let mut room_meta = vec![(1, 1), (1, 0)];
+    for &(l, from, to) in &metas {
+        pos.extend(meta_atoms_2d(from.0, from.1, sp));
+        goal_pos.extend(meta_atoms_2d(to.0, to.1, sp));
+        label.extend([l; 4]);
+        room_meta.extend([from, to]);
+    }
+    for (mx, my) in room_meta {
+        for x in 2 * mx * sp..(2 * mx + 2) * sp {
+            for y in 2 * my * sp..(2 * my + 2) * sp {
+                room.insert(Cell::new(x, y, 0));
+            }
+        }
+    }
+    let faces = [rest == crate::lattice::AtomRest::Expanded; 6];
+    let ext = vec![faces; pos.len()];
+    let start = Scene {
+        bonds: Scene::all_bonds(&pos, &ext),
+        pos,
+        ext: ext.clone(),
+    };
+    let goal = Scene {
+        bonds: Scene::all_bonds(&goal_pos, &ext),
+        pos: goal_pos,
+        ext,
+    };
+    let is = |a: usize, l: &str| l.contains(label[a]);
+    let n = label.len();
+    let problem = Problem {
+        start,
+        goal,
+        actors: (0..n).filter(|&a| is(a, "AB")).collect(),
+        faces: vec![Face::PosX, Face::NegX, Face::PosY, Face::NegY],
+        latchable: (0..n).collect(),
+        pinned: (0..n)
+            .filter_map(|a| match label[a] {
+                'D' => Some((a, 0)),
+                'E' => Some((a, 1)),
+                _ => None,
+            })
+            .collect(),
+        anchors: vec![0],
+        reach: 2 * sp + 1,
+        max_ops: 60,
+        eps: 1e-6,
+        room: Some(room),
+        exchange: true,
+    };
+    (problem, label)
 }

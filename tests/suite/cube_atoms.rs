@@ -435,3 +435,130 @@ fn robots_that_are_not_aligned_blocks_or_not_connected_are_refused_naming_file_a
         assert!(err.contains(reason), "{name}: {err}");
     }
 }
+
+/// A meta-module robot (`meta_modules: contracted`) of `metas` (id, cell,
+/// fixed), with `steps`.
+fn meta_doc(metas: &[(u32, [i32; 3], bool)], steps: Value) -> Value {
+    let modules: Vec<Value> = metas
+        .iter()
+        .map(|&(id, c, fixed)| json!({"id": id, "cell": c, "fixed": fixed}))
+        .collect();
+    json!({
+        "format": "reconfcheck-schedule", "version": 1, "lattice": "cubic",
+        "spacing": {"value": 60.0, "unit": "mm"}, "meta_modules": "contracted",
+        "modules": modules, "steps": steps,
+    })
+}
+
+/// The 1-TUNNEL((x, y + 1), (x + 1, y)) of seed 004 Fig. 12 inside a
+/// robot whose bounding boxes hold the corner between the legs: A (id 3)
+/// on the turn B (2), B on L (1), L on L2 (0, fixed), and G (4) on L2,
+/// which keeps the target's box as high as the source's. `map` places the
+/// robot (turned or mirrored).
+fn tunnel_robot(map: impl Fn([i32; 3]) -> [i32; 3]) -> (Vec<(u32, [i32; 3], bool)>, Value) {
+    let metas = vec![
+        (0, map([-2, 0, 0]), true),
+        (1, map([-1, 0, 0]), false),
+        (2, map([0, 0, 0]), false),
+        (3, map([0, 1, 0]), false),
+        (4, map([-2, 1, 0]), false),
+    ];
+    let path = json!([map([0, 1, 0]), map([0, 0, 0]), map([1, 0, 0])]);
+    (
+        metas,
+        json!([{"events": [{"op": "tunnel", "module": 3, "path": path}]}]),
+    )
+}
+
+#[test]
+fn a_derived_one_tunnel_certifies_atom_by_atom_turned_and_mirrored() {
+    let lib = reconfcheck::geometry::atom_expand::tunnel_library(AtomRest::Contracted)
+        .expect("the contracted 1-TUNNEL is found");
+    eprintln!(
+        "1-TUNNEL, contracted: {} parallel steps, {} atom operations in 3D (2D slice: {} ops, {} states)",
+        lib.steps.len(),
+        lib.steps.iter().map(Vec::len).sum::<usize>(),
+        lib.found.ops.len(),
+        lib.found.states_explored
+    );
+    // As placed; mirrored in x; turned so that the legs are z and −y and
+    // the slice is lifted along x.
+    let maps: [fn([i32; 3]) -> [i32; 3]; 3] =
+        [|c| c, |[x, y, z]| [-x, y, z], |[x, y, z]| [z, -x, y]];
+    for (k, map) in maps.into_iter().enumerate() {
+        let (metas, steps) = tunnel_robot(map);
+        let doc = meta_doc(&metas, steps);
+        let s = Schedule::from_json(&doc.to_string(), Path::new("t.json")).unwrap();
+        let r = run(&s);
+        assert!(r.certified, "placement {k}:\n{}", r.summary());
+        assert_eq!(r.steps, lib.steps.len(), "placement {k}");
+    }
+    // Without G the corner is outside both bounding boxes: the move is
+    // not in place, and the certifier says so.
+    let (mut metas, steps) = tunnel_robot(|c| c);
+    metas.pop();
+    let s = Schedule::from_json(&meta_doc(&metas, steps).to_string(), Path::new("t.json")).unwrap();
+    let r = run(&s);
+    assert!(!r.certified);
+    assert!(
+        kinds(&r).contains(&ViolationKind::OutOfPlace),
+        "{}",
+        r.summary()
+    );
+}
+
+#[test]
+fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
+    let (metas, _) = tunnel_robot(|c| c);
+    let cases = [
+        (
+            "straight.json",
+            json!([[0, 1, 0], [0, 0, 0], [0, -1, 0]]),
+            "turns once",
+        ),
+        (
+            "long.json",
+            json!([[0, 1, 0], [0, 0, 0], [1, 0, 0], [2, 0, 0]]),
+            "path of 4 cells",
+        ),
+        (
+            "nohold.json",
+            json!([[0, 1, 0], [0, 0, 0], [-1, 0, 0]]),
+            "must hang on a meta-module at (1, 0, 0), opposite the exit",
+        ),
+    ];
+    for (name, path, needle) in cases {
+        let doc = meta_doc(
+            &metas,
+            json!([{"events": [{"op": "tunnel", "module": 3, "path": path}]}]),
+        );
+        let (code, err) = cli_certify(name, &doc);
+        assert_eq!(code, Some(2), "{name}: {err}");
+        for n in [name, "step 1", "module 3", needle] {
+            assert!(err.contains(n), "{name}: lacks {n}: {err}");
+        }
+    }
+    // A tunnelling meta-module that is not a leaf.
+    let mut metas2 = metas.clone();
+    metas2.push((5, [0, 2, 0], false));
+    let doc = meta_doc(
+        &metas2,
+        json!([{"events": [{"op": "tunnel", "module": 3, "path": [[0, 1, 0], [0, 0, 0], [1, 0, 0]]}]}]),
+    );
+    let (code, err) = cli_certify("leaf.json", &doc);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("must be a leaf"), "{err}");
+    // The exit taken.
+    let mut metas3 = metas.clone();
+    metas3.push((5, [1, 0, 0], false));
+    let doc = meta_doc(
+        &metas3,
+        json!([{"events": [{"op": "tunnel", "module": 3, "path": [[0, 1, 0], [0, 0, 0], [1, 0, 0]]}]}]),
+    );
+    let (code, err) = cli_certify("exit.json", &doc);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("the exit (1, 0, 0) is taken by meta-module 5"),
+        "{err}"
+    );
+}
