@@ -250,12 +250,6 @@ fn one_tunnel(
             "a 1-TUNNEL path turns once between neighbouring cells; {a}, {b}, {c} do not"
         ));
     }
-    tunnel_library(rest).ok_or_else(|| {
-        format!(
-            "no atom sequence for 1-TUNNEL was derived in the {} model",
-            format!("{rest:?}").to_lowercase()
-        )
-    })?;
     let turn_id = *by_cell
         .get(b)
         .ok_or_else(|| format!("the tunnel turns at {b}, where there is no meta-module"))?;
@@ -287,6 +281,13 @@ fn one_tunnel(
             ));
         }
     }
+    // Searched last, and once per process: refusals above cost nothing.
+    tunnel_library(rest).ok_or_else(|| {
+        format!(
+            "no atom sequence for 1-TUNNEL was derived in the {} model",
+            format!("{rest:?}").to_lowercase()
+        )
+    })?;
     Ok(PlacedTunnel {
         b: turn_id,
         l,

@@ -510,26 +510,45 @@ fn a_derived_one_tunnel_certifies_atom_by_atom_turned_and_mirrored() {
 #[test]
 fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
     let (metas, _) = tunnel_robot(|c| c);
+    let turn = json!([[0, 1, 0], [0, 0, 0], [1, 0, 0]]);
+    // (file, a meta-module added to the robot, the path, what the error says)
     let cases = [
         (
             "straight.json",
+            None,
             json!([[0, 1, 0], [0, 0, 0], [0, -1, 0]]),
             "turns once",
         ),
         (
             "long.json",
+            None,
             json!([[0, 1, 0], [0, 0, 0], [1, 0, 0], [2, 0, 0]]),
             "path of 4 cells",
         ),
         (
             "nohold.json",
+            None,
             json!([[0, 1, 0], [0, 0, 0], [-1, 0, 0]]),
             "must hang on a meta-module at (1, 0, 0), opposite the exit",
         ),
+        (
+            "leaf.json",
+            Some((5, [0, 2, 0], false)),
+            turn.clone(),
+            "must be a leaf on the turn; meta-module 5 at (0, 2, 0)",
+        ),
+        (
+            "exit.json",
+            Some((5, [1, 0, 0], false)),
+            turn,
+            "the exit (1, 0, 0) is taken by meta-module 5",
+        ),
     ];
-    for (name, path, needle) in cases {
+    for (name, extra, path, needle) in cases {
+        let mut robot = metas.clone();
+        robot.extend(extra);
         let doc = meta_doc(
-            &metas,
+            &robot,
             json!([{"events": [{"op": "tunnel", "module": 3, "path": path}]}]),
         );
         let (code, err) = cli_certify(name, &doc);
@@ -538,27 +557,4 @@ fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
             assert!(err.contains(n), "{name}: lacks {n}: {err}");
         }
     }
-    // A tunnelling meta-module that is not a leaf.
-    let mut metas2 = metas.clone();
-    metas2.push((5, [0, 2, 0], false));
-    let doc = meta_doc(
-        &metas2,
-        json!([{"events": [{"op": "tunnel", "module": 3, "path": [[0, 1, 0], [0, 0, 0], [1, 0, 0]]}]}]),
-    );
-    let (code, err) = cli_certify("leaf.json", &doc);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("must be a leaf"), "{err}");
-    // The exit taken.
-    let mut metas3 = metas.clone();
-    metas3.push((5, [1, 0, 0], false));
-    let doc = meta_doc(
-        &metas3,
-        json!([{"events": [{"op": "tunnel", "module": 3, "path": [[0, 1, 0], [0, 0, 0], [1, 0, 0]]}]}]),
-    );
-    let (code, err) = cli_certify("exit.json", &doc);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("the exit (1, 0, 0) is taken by meta-module 5"),
-        "{err}"
-    );
 }
