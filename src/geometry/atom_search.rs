@@ -786,9 +786,9 @@ impl Legs {
 /// in the same place within its meta-module. Legs: D (0, 2) behind A ends
 /// at (0, 1), E (1, 0) ahead ends at (2, 0); they may move only along
 /// their leg and do not act. Room: the cells of the path, L, and the
-/// corner (1, 1) between the two legs, which is inside the robot's
-/// bounding box whenever the legs are (and empty wherever the combing
-/// tunnels, next to a leaf at the end of a comb's teeth). Only A's and
+/// corner (1, 1) between the two legs, which a comb's bounding boxes
+/// usually hold where it tunnels (docs/atoms.md); where a robot's boxes
+/// do not, the certifier refuses the move as out of place. Only A's and
 /// B's atoms act. Atom order: L, B, A, then D and E. Returns the problem
 /// and each atom's meta-module label.
 pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, Vec<char>) {
