@@ -56,24 +56,6 @@ impl Setup {
     }
 }
 
-fn canonical(s: &Scene) -> Scene {
-    let mut idx: Vec<usize> = (0..s.pos.len()).collect();
-    idx.sort_by_key(|&i| ((s.pos[i].x, s.pos[i].y, s.pos[i].z), s.ext[i]));
-    let mut inv = vec![0; idx.len()];
-    for (k, &i) in idx.iter().enumerate() {
-        inv[i] = k;
-    }
-    Scene {
-        pos: idx.iter().map(|&i| s.pos[i]).collect(),
-        ext: idx.iter().map(|&i| s.ext[i]).collect(),
-        bonds: s
-            .bonds
-            .iter()
-            .map(|&(a, b)| (inv[a].min(inv[b]), inv[a].max(inv[b])))
-            .collect(),
-    }
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let has = |f: &str| args.iter().any(|a| a == f);
@@ -108,7 +90,7 @@ fn main() {
     }
     let ext = vec![[false; 6]; pos.len()];
     let bonds = Scene::all_bonds(&pos, &ext);
-    let start = canonical(&Scene { pos, ext, bonds });
+    let start = Scene { pos, ext, bonds }.canonical().0;
     let mut goal: BTreeSet<Cell> = layers(&b).into_iter().chain(layers(&e)).collect();
     if with_l {
         goal.extend(layers(&l));
@@ -214,7 +196,7 @@ fn main() {
                         .iter()
                         .all(|f| !e[f.index()] || set.inside(*p + f.dir()))
             });
-            let next = canonical(&next);
+            let next = next.canonical().0;
             if !in_place || parent.contains_key(&next) {
                 continue;
             }

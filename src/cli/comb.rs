@@ -59,7 +59,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         Some(t) => println!(
             "1-TUNNEL, contracted (a leaf through one turn, legs of one meta-module; paper: O(1)): {} steps, {} ops, {} states",
             t.steps.len(),
-            t.steps.iter().map(Vec::len).sum::<usize>(),
+            t.atom_operations(),
             t.found.states_explored
         ),
         None => println!("1-TUNNEL, contracted: not found"),

@@ -98,6 +98,13 @@ pub struct TunnelLibrary {
     pub steps: Vec<Vec<Op>>,
 }
 
+impl TunnelLibrary {
+    /// Atom operations of the 3D move.
+    pub fn atom_operations(&self) -> usize {
+        self.steps.iter().map(Vec::len).sum()
+    }
+}
+
 /// Bound of the 1-TUNNEL search (states); the contracted model's move is
 /// found after about 220,000.
 pub const TUNNEL_MAX_STATES: usize = 3_000_000;
@@ -111,7 +118,11 @@ pub fn tunnel_library(rest: AtomRest) -> Option<&'static TunnelLibrary> {
     }
     CONTRACTED
         .get_or_init(|| {
-            let (problem, _) = tunnel_problem(rest, Legs::ALL[0]);
+            let legs = Legs {
+                behind: false,
+                ahead: false,
+            };
+            let (problem, _) = tunnel_problem(rest, legs);
             let found = problem.solve_guided(2, TUNNEL_MAX_STATES)?;
             let mut end = problem.start.clone();
             for st in &found.steps {
@@ -189,6 +200,21 @@ fn atoms_of(id: ModuleId, c: Cell, sp: i32) -> impl Iterator<Item = ModuleSpec> 
     })
 }
 
+/// Each meta-module's atoms by local index (`i + 2j + 4k`).
+type Owners = FxHashMap<ModuleId, [ModuleId; 8]>;
+
+/// The world atom of atom `q` of a lifted 2D scene (atom `q / 2` of the
+/// slice, at height `q % 2`; the slice's meta-modules, four atoms each,
+/// are `ids`), placed by `turn`. Ids without atoms (the double slide's
+/// absent F and H, which never act) fall back to the start's numbering.
+fn lifted_atom(q: usize, ids: &[ModuleId], turn: &Turn, owner: &Owners) -> ModuleId {
+    let a2 = q / 2;
+    let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
+    let m = ids[a2 / 4];
+    let l = turn.local(i, j, (q % 2) as i32);
+    owner.get(&m).map_or(m * 8 + l, |o| o[l as usize])
+}
+
 /// The touching atom pairs of meta-modules at `ca` and `cb`, as local
 /// atom indices (`i + 2j + 4k`) of the first and of the second.
 fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
@@ -216,6 +242,7 @@ fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
 /// A 1-TUNNEL placed in the robot: the turn B, the static neighbour L
 /// opposite the exit, the exit cell, and the symmetry's canonical −x and −y.
 struct PlacedTunnel {
+    lib: &'static TunnelLibrary,
     b: ModuleId,
     l: ModuleId,
     exit: Cell,
@@ -282,13 +309,14 @@ fn one_tunnel(
         }
     }
     // Searched last, and once per process: refusals above cost nothing.
-    tunnel_library(rest).ok_or_else(|| {
+    let lib = tunnel_library(rest).ok_or_else(|| {
         format!(
             "no atom sequence for 1-TUNNEL was derived in the {} model",
             format!("{rest:?}").to_lowercase()
         )
     })?;
     Ok(PlacedTunnel {
+        lib,
         b: turn_id,
         l,
         exit: *c,
@@ -301,9 +329,6 @@ fn one_tunnel(
 pub fn expand(s: &Schedule, rest: AtomRest) -> Result<Schedule, InputError> {
     Ok(expand_tracked(s, rest)?.0)
 }
-
-/// Each meta-module's atoms by local index (`i + 2j + 4k`) at the end.
-type Owners = FxHashMap<ModuleId, [ModuleId; 8]>;
 
 /// [`expand`], with each meta-module's atoms and cell at the end.
 fn expand_tracked(
@@ -320,7 +345,7 @@ fn expand_tracked(
     let mut at: FxHashMap<ModuleId, Cell> = FxHashMap::default();
     // The atoms of each meta-module by local index: `8·id + l` at the
     // start; a tunnel exchanges atoms between the meta-modules it involves.
-    let mut owner: FxHashMap<ModuleId, [ModuleId; 8]> = FxHashMap::default();
+    let mut owner: Owners = FxHashMap::default();
     let mut by_cell: FxHashMap<Cell, ModuleId> = FxHashMap::default();
     for m in &s.modules {
         if m.id > u32::MAX / 8 - 1 {
@@ -411,17 +436,10 @@ fn expand_tracked(
                 }
                 Event::Tunnel { path, .. } => {
                     let t = one_tunnel(here, path, &by_cell, rest).map_err(err)?;
-                    let lib = tunnel_library(rest).expect("one_tunnel found the library");
+                    let lib = t.lib;
                     let turn = Turn::new(t.d, t.w);
                     let ids = [t.l, t.b, id];
-                    let local = |q: usize| -> ((i32, i32), usize) {
-                        let a2 = q / 2;
-                        ([(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4], a2 / 4)
-                    };
-                    let atom = |q: usize| -> ModuleId {
-                        let ((i, j), meta) = local(q);
-                        owner[&ids[meta]][turn.local(i, j, (q % 2) as i32) as usize]
-                    };
+                    let atom = |q: usize| lifted_atom(q, &ids, &turn, &owner);
                     slides.push(
                         lib.steps
                             .iter()
@@ -482,15 +500,7 @@ fn expand_tracked(
                 }
             };
             let turn = Turn::new(d, w);
-            let atom = |q: usize| -> ModuleId {
-                let a2 = q / 2;
-                let meta = a2 / 4;
-                let (i, j) = [(0, 0), (1, 0), (0, 1), (1, 1)][a2 % 4];
-                let m = ids[meta];
-                let l = turn.local(i, j, (q % 2) as i32);
-                // F and H of the double slide's scene (ids 0) never act.
-                owner.get(&m).map_or(m * 8 + l, |o| o[l as usize])
-            };
+            let atom = |q: usize| lifted_atom(q, &ids, &turn, &owner);
             let steps: Vec<Vec<Event>> = lib
                 .steps
                 .iter()
@@ -568,7 +578,6 @@ mod tests {
 
     /// Replays an atom schedule's events with the search's step rules.
     fn replay(atoms: &Schedule) -> FxHashMap<ModuleId, Cell> {
-        use super::super::atom_search::Scene;
         let ids: Vec<ModuleId> = atoms.modules.iter().map(|m| m.id).collect();
         let ix = |m: ModuleId| ids.iter().position(|&i| i == m).unwrap();
         let pos: Vec<Cell> = atoms.modules.iter().map(|m| m.cell).collect();

@@ -49,6 +49,23 @@ impl Op {
         }
     }
 
+    /// The same operation on the atoms `f` names (a latch's pair kept in
+    /// ascending order).
+    pub fn renamed(self, f: impl Fn(usize) -> usize) -> Op {
+        match self {
+            Op::Expand(a, face) => Op::Expand(f(a), face),
+            Op::Contract(a, face) => Op::Contract(f(a), face),
+            Op::Attach(a, b) => {
+                let (a, b) = pair(f(a), f(b));
+                Op::Attach(a, b)
+            }
+            Op::Detach(a, b) => {
+                let (a, b) = pair(f(a), f(b));
+                Op::Detach(a, b)
+            }
+        }
+    }
+
     /// The atoms the operation names.
     pub fn atoms(&self) -> (usize, Option<usize>) {
         match *self {
@@ -458,12 +475,7 @@ impl Problem {
         let mut out = Vec::with_capacity(canonical_ops.len());
         for &op in canonical_ops {
             let (_, idx) = real.canonical();
-            let named = match op {
-                Op::Expand(a, f) => Op::Expand(idx[a], f),
-                Op::Contract(a, f) => Op::Contract(idx[a], f),
-                Op::Attach(a, b) => Op::Attach(pair(idx[a], idx[b]).0, pair(idx[a], idx[b]).1),
-                Op::Detach(a, b) => Op::Detach(pair(idx[a], idx[b]).0, pair(idx[a], idx[b]).1),
-            };
+            let named = op.renamed(|a| idx[a]);
             real = real
                 .step(&[named], &self.anchors, self.eps)
                 .expect("a found operation replays on the start's atoms");
@@ -720,14 +732,7 @@ pub fn lift(scene: &Scene, steps: &[Vec<Op>], sp: i32) -> (Scene, Vec<Vec<Op>>) 
         .iter()
         .map(|st| {
             st.iter()
-                .flat_map(|op| {
-                    (0..2).map(move |z| match *op {
-                        Op::Expand(a, f) => Op::Expand(2 * a + z, f),
-                        Op::Contract(a, f) => Op::Contract(2 * a + z, f),
-                        Op::Attach(a, b) => Op::Attach(2 * a + z, 2 * b + z),
-                        Op::Detach(a, b) => Op::Detach(2 * a + z, 2 * b + z),
-                    })
-                })
+                .flat_map(|op| (0..2).map(move |z| op.renamed(|a| 2 * a + z)))
                 .collect()
         })
         .collect();
@@ -780,12 +785,14 @@ impl Legs {
 /// The labelled scene of 1-TUNNEL((x, y + 1), (x + 1, y)) in a 2D slice
 /// (seed 004 Fig. 12): the leaf A at meta cell (0, 1) is pushed into the
 /// turn B (0, 0), whose mass pops out at (1, 0). B hangs on the rest of
-/// the robot through L (−1, 0), opposite the way out (the frame). Atoms
-/// are not exchanged between meta-modules (the paper's implementations
-/// avoid it): A's atoms end where B's were, B's one cell along +x, each
-/// in the same place within its meta-module. Legs: D (0, 2) behind A ends
-/// at (0, 1), E (1, 0) ahead ends at (2, 0); they may move only along
-/// their leg and do not act. Room: the cells of the path, L, and the
+/// the robot through L (−1, 0), opposite the way out (the frame). The
+/// goal lists A's atoms where B's were and B's one cell along +x, but the
+/// problem treats atoms as interchangeable (`exchange`): no sequence that
+/// keeps each meta-module's atoms was found (docs/atoms.md), so any atoms
+/// on the goal's cells meet it. Legs: D (0, 2) behind A ends at (0, 1),
+/// E (1, 0) ahead ends at (2, 0); they do not act, and, atoms being
+/// interchangeable, nothing keeps a leg's atoms on their leg (a looser
+/// search than a rigid leg). Room: the cells of the path, L, and the
 /// corner (1, 1) between the two legs, which a comb's bounding boxes
 /// usually hold where it tunnels (docs/atoms.md); where a robot's boxes
 /// do not, the certifier refuses the move as out of place. Only A's and
@@ -842,13 +849,8 @@ pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, V
         actors: (0..n).filter(|&a| is(a, "AB")).collect(),
         faces: vec![Face::PosX, Face::NegX, Face::PosY, Face::NegY],
         latchable: (0..n).collect(),
-        pinned: (0..n)
-            .filter_map(|a| match label[a] {
-                'D' => Some((a, 0)),
-                'E' => Some((a, 1)),
-                _ => None,
-            })
-            .collect(),
+        // Per-atom bounds mean nothing when atoms are interchangeable.
+        pinned: Vec::new(),
         anchors: vec![0],
         reach: 2 * sp + 1,
         max_ops: 60,

@@ -477,7 +477,7 @@ fn a_derived_one_tunnel_certifies_atom_by_atom_turned_and_mirrored() {
     eprintln!(
         "1-TUNNEL, contracted: {} parallel steps, {} atom operations in 3D (2D slice: {} ops, {} states)",
         lib.steps.len(),
-        lib.steps.iter().map(Vec::len).sum::<usize>(),
+        lib.atom_operations(),
         lib.found.ops.len(),
         lib.found.states_explored
     );
