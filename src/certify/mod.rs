@@ -12,6 +12,7 @@ pub mod jobs;
 pub(crate) mod junit;
 pub(crate) mod lattice_check;
 pub(crate) mod load_check;
+pub mod meta_check;
 pub(crate) mod report;
 pub(crate) mod world;
 
@@ -60,6 +61,9 @@ pub struct Options {
     /// reported one may lie, as a fraction of it (0: exact; see
     /// `Settings::load_factor_tolerance` in the mechanics).
     pub load_factor_tolerance: f64,
+    /// A meta-module schedule is certified at the meta-module level only
+    /// ([`meta_check`]), not expanded into atom operations.
+    pub meta_level: bool,
 }
 
 /// A range of steps that has been checked, and how long it took.
@@ -97,6 +101,7 @@ impl Default for Options {
             range_steps: None,
             range_done: None,
             load_factor_tolerance: 0.0,
+            meta_level: false,
         }
     }
 }
@@ -281,6 +286,14 @@ pub fn certify_by(
 ) -> Result<Report, InputError> {
     if let Some(rest) = schedule.atoms {
         return atom_check::certify_atoms(schedule, rest, opts);
+    }
+    if opts.meta_level {
+        if schedule.meta_modules.is_none() {
+            return Err(InputError::new(
+                "--meta-level certifies meta-module schedules (`meta_modules` set) only",
+            ));
+        }
+        return meta_check::certify_meta_level(schedule, opts);
     }
     if let Some(rest) = schedule.meta_modules {
         let atoms = crate::geometry::atom_expand::expand(schedule, rest)?;

@@ -53,6 +53,11 @@ pub enum ViolationKind {
     /// Seed 004 atoms: an atom leaves the union of the source's and the
     /// target's bounding boxes (the paper's in-place claim).
     OutOfPlace,
+    /// Seed 004 meta-modules: a k-TUNNEL whose start is not a leaf, whose
+    /// legs are attached to other meta-modules between turns, whose path
+    /// is not static and occupied or whose exit is not free, or that turns
+    /// more than 4 times.
+    TunnelPrecondition,
 }
 
 impl ViolationKind {
@@ -240,7 +245,11 @@ impl Report {
     /// with the reason, so that a lattice-only pass is never read as a
     /// full certificate.
     pub fn coverage(&self) -> (Vec<String>, Vec<String>) {
-        let ran = |name: &str| self.checks.iter().any(|c| c == name);
+        let ran = |name: &str| {
+            self.checks
+                .iter()
+                .any(|c| c == name || c.starts_with(&format!("atoms: {name}")))
+        };
         let no_model = self
             .checks
             .iter()
@@ -257,7 +266,17 @@ impl Report {
             .map(|c| format!("{c} ({covered})"))
             .collect();
         let mut not_checked = Vec::new();
-        if !ran("collision") {
+        let meta = self
+            .checks
+            .iter()
+            .any(|c| c.starts_with("meta-module level"));
+        if meta {
+            not_checked.push(
+                "atoms (kinematics, collisions, their connectivity and in-place bound) and mechanics: meta-module level only (--meta-level)"
+                    .to_string(),
+            );
+        }
+        if !meta && !ran("collision") {
             not_checked.push(if crate::geometry::sweep_model(self.lattice).is_none() {
                 format!(
                     "collision: no body model for the {} lattice",
@@ -269,7 +288,7 @@ impl Report {
                 "collision: not requested".to_string()
             });
         }
-        if !ran("mechanics") {
+        if !meta && !ran("mechanics") {
             not_checked.push(if no_model {
                 "mechanics: no physical model (pass --model FILE or name one in the schedule)"
                     .to_string()

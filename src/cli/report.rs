@@ -31,6 +31,12 @@ pub struct ReportArgs {
     /// Run the lattice checks only (occupancy, pivots, connectivity).
     #[arg(long)]
     lattice_only: bool,
+    /// Certify a meta-module schedule (seed 004) at the meta-module level:
+    /// the paper's SLIDE and k-TUNNEL preconditions, latches,
+    /// connectivity and the in-place bound, without expanding it into
+    /// atom operations (for moves with no derived atom sequence).
+    #[arg(long)]
+    meta_level: bool,
     /// Physical model (TOML, see models/) for the gravity and connector-load
     /// check; overrides the schedule's own `model`.
     #[arg(long, value_name = "FILE")]
@@ -90,6 +96,7 @@ impl ReportArgs {
                 .is_some()
                 .then_some(print_range_time),
             load_factor_tolerance: t,
+            meta_level: self.meta_level,
         })
     }
 }

@@ -375,6 +375,7 @@ fn expand_tracked(
         let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
             FxHashMap::default();
         let mut retag: Vec<(ModuleId, [ModuleId; 8], ModuleId, [ModuleId; 8])> = Vec::new();
+        let mut wall_cells: FxHashMap<ModuleId, Cell> = FxHashMap::default();
         for e in &step.events {
             let id = e.module();
             let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
@@ -433,6 +434,7 @@ fn expand_tracked(
                         err(format!("SLIDE needs a meta-module at {} (beside the wall, in the slide direction)", cb + d))
                     })?;
                     walls.entry(id).or_default().push((d, w, *b, c));
+                    wall_cells.entry(id).or_insert(here);
                 }
                 Event::Tunnel { path, .. } => {
                     let t = one_tunnel(here, path, &by_cell, rest).map_err(err)?;
@@ -480,18 +482,47 @@ fn expand_tracked(
         for id in ids_in_order {
             let ws = &walls[&id];
             let err = |m: String| InputError::new(m).at_step(k1).for_module(id);
+            // A slider pushing a carried meta-module ahead of it (a comb
+            // run in reverse) runs the derived SLIDE backwards: the slide
+            // from its end cell back to its start, along the meta-module
+            // beside its wall ahead, with every step's operations undone
+            // in reverse order. The derived SLIDE carries loads behind and
+            // on the far side only.
+            let here = wall_cells[&id];
+            let d0 = ws[0].0;
+            let carried = |c: Cell| {
+                by_cell
+                    .get(&c)
+                    .is_some_and(|m| moved.iter().any(|&(o, to)| o == *m && to == c + d0))
+            };
+            let back = carried(here + d0);
+            if back && carried(here - d0) {
+                return Err(err(
+                    "a SLIDE carrying meta-modules both ahead of and behind the slider has no derived atom sequence".into(),
+                ));
+            }
             let (lib, ids, (d, w)) = match ws.as_slice() {
                 [(d, w, b, c)] => {
                     let lib = slide_library(rest).ok_or_else(|| {
                         err("no atom sequence for SLIDE was found by the search".into())
                     })?;
-                    (lib, vec![*b, *c, id], (*d, *w))
+                    let ids = if back {
+                        vec![*c, *b, id]
+                    } else {
+                        vec![*b, *c, id]
+                    };
+                    (lib, ids, (*d, *w))
                 }
                 [(d, w, b, c), (d2, w2, b2, c2)] if d == d2 && *w2 == Cell::ZERO - *w => {
                     let lib = double_slide_library(rest).ok_or_else(|| {
                         err("no atom sequence for a SLIDE between two walls was found by the search".into())
                     })?;
-                    (lib, vec![*b, *c, id, 0, 0, *b2, *c2], (*d, *w))
+                    let ids = if back {
+                        vec![*c, *b, id, 0, 0, *c2, *b2]
+                    } else {
+                        vec![*b, *c, id, 0, 0, *b2, *c2]
+                    };
+                    (lib, ids, (*d, *w))
                 }
                 _ => {
                     return Err(err(
@@ -499,17 +530,24 @@ fn expand_tracked(
                     ));
                 }
             };
-            let turn = Turn::new(d, w);
+            let turn = Turn::new(if back { Cell::ZERO - d } else { d }, w);
             let atom = |q: usize| lifted_atom(q, &ids, &turn, &owner);
-            let steps: Vec<Vec<Event>> = lib
-                .steps
-                .iter()
-                .map(|st| {
-                    st.iter()
-                        .map(|op| op.event(atom, |f| turn.face(f)))
-                        .collect()
-                })
-                .collect();
+            let event = |op: &Op| {
+                let op = if back { op.inverse() } else { *op };
+                op.event(atom, |f| turn.face(f))
+            };
+            let steps: Vec<Vec<Event>> = if back {
+                lib.steps
+                    .iter()
+                    .rev()
+                    .map(|st| st.iter().map(event).collect())
+                    .collect()
+            } else {
+                lib.steps
+                    .iter()
+                    .map(|st| st.iter().map(event).collect())
+                    .collect()
+            };
             slides.push(steps);
         }
         if !latch.is_empty() {

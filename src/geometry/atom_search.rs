@@ -66,6 +66,19 @@ impl Op {
         }
     }
 
+    /// The operation that undoes this one: run a valid parallel step's
+    /// inverses together from its end and the robot retraces it (an arm
+    /// sweeps the same box either way; the bonds held through the step
+    /// are the same set).
+    pub fn inverse(self) -> Op {
+        match self {
+            Op::Expand(a, f) => Op::Contract(a, f),
+            Op::Contract(a, f) => Op::Expand(a, f),
+            Op::Attach(a, b) => Op::Detach(a, b),
+            Op::Detach(a, b) => Op::Attach(a, b),
+        }
+    }
+
     /// The atoms the operation names.
     pub fn atoms(&self) -> (usize, Option<usize>) {
         match *self {

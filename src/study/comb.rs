@@ -82,6 +82,175 @@ pub fn run(
     Ok(rows)
 }
 
+/// One size of Theorem 1 in 2D (source to target through the common comb).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TheoremRow {
+    pub metas: usize,
+    pub atoms: usize,
+    /// Meta-module steps of each phase: the source's combing, its comb to
+    /// the common comb, the target's comb-to-common-comb reversed (with the
+    /// latch steps joining the two), the target's combing reversed.
+    pub phase_steps: [usize; 4],
+    /// Tunnels with one and with two turns (phases 2 and 3).
+    pub tunnels: [usize; 2],
+    /// Tunnels whose every leg is one meta-module long: the only ones with
+    /// a derived atom sequence.
+    pub short_tunnels: usize,
+    /// The longest leg of any tunnel (meta-modules between its end and its
+    /// turn, or between two turns).
+    pub longest_leg: usize,
+    /// Parallel steps and atom operations of the two combing phases,
+    /// expanded into atom operations (the tunnels of the other two are not).
+    pub comb_steps: usize,
+    pub comb_operations: usize,
+    /// Whether the whole schedule certifies at the meta-module level, and
+    /// the combing phases atom by atom (lattice, collision, connectivity,
+    /// in place), with the seconds each took.
+    pub meta_certified: Option<bool>,
+    pub atoms_certified: Option<bool>,
+    pub generate_s: f64,
+    pub certify_s: Option<f64>,
+}
+
+/// Legs of an orthogonal path: the straight runs between its ends and
+/// turns, each as the number of cell-to-cell steps it makes (a 1-TUNNEL
+/// of Fig. 12, leaf on the turn and exit beside it: legs 1 and 1).
+fn legs(path: &[crate::lattice::Cell]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut run = 1;
+    for w in path.windows(3) {
+        if w[1] - w[0] == w[2] - w[1] {
+            run += 1;
+        } else {
+            out.push(run);
+            run = 1;
+        }
+    }
+    out.push(run);
+    out
+}
+
+/// Theorem 1 at each size: a seeded random source and target of `m`
+/// meta-modules; certifies up to `certify_up_to` meta-modules.
+pub fn theorem(
+    sizes: &[usize],
+    seed: u64,
+    rest: AtomRest,
+    certify_up_to: usize,
+) -> Result<Vec<TheoremRow>, InputError> {
+    use crate::algorithms::comb::common_comb::{reconfigure, turns};
+    use crate::algorithms::comb::{meta_schedule_at, meta_schedule_framed};
+    use crate::schedule::Event;
+    let mut rows = Vec::new();
+    for &m in sizes {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (m as u64).wrapping_mul(0x85EB_CA6B));
+        let (src, tgt) = (random_polyomino(m, &mut rng), random_polyomino(m, &mut rng));
+        let t0 = Instant::now();
+        let plan = reconfigure(&src, &tgt);
+        let whole = meta_schedule_framed(&src, &plan.steps(), rest, None);
+        // The combing phases alone, from the robot where each starts.
+        let mut robot = Robot::new(&src);
+        // Each phase's frame: a meta-module it never moves (the source's,
+        // the target's lowest row).
+        let lowest =
+            |s: &crate::algorithms::comb::Shape| s.iter().min_by_key(|c| (c.1, c.0)).copied();
+        let first = meta_schedule_at(&robot.at, &plan.phases[0], rest, lowest(&src));
+        for es in plan.phases[..3].iter().flatten() {
+            robot.apply(es);
+        }
+        // A schedule starts with every neighbouring pair attached: first
+        // let go of the pairs the robot has detached by then.
+        let loose: Vec<Event> = {
+            let mut v: Vec<(usize, usize)> = Vec::new();
+            for (a, &(x, y)) in robot.at.iter().enumerate() {
+                for n in [(x + 1, y), (x, y + 1)] {
+                    if let Some(b) = robot.get(n)
+                        && !robot.attached.contains(&(a.min(b), a.max(b)))
+                    {
+                        v.push((a, b));
+                    }
+                }
+            }
+            v.into_iter()
+                .map(|(a, b)| Event::Detach {
+                    module: a as u32,
+                    other: b as u32,
+                })
+                .collect()
+        };
+        let mut phase4 = plan.phases[3].clone();
+        if !loose.is_empty() {
+            phase4.insert(0, loose);
+        }
+        let last = meta_schedule_at(&robot.at, &phase4, rest, lowest(&plan.target));
+        let (a, b) = (expand(&first, rest)?, expand(&last, rest)?);
+        let generate_s = t0.elapsed().as_secs_f64();
+        let mut tunnels = [0; 2];
+        let (mut short, mut longest) = (0, 0);
+        for e in plan.phases[1..3].iter().flatten().flatten() {
+            if let Event::Tunnel { path, .. } = e {
+                let p: Vec<(i32, i32)> = path.iter().map(|c| (c.x, c.y)).collect();
+                tunnels[turns(&p).clamp(1, 2) - 1] += 1;
+                let l = legs(path);
+                short += usize::from(l.iter().all(|&n| n == 1));
+                longest = longest.max(l.into_iter().max().unwrap_or(0));
+            }
+        }
+        let (mut meta_certified, mut atoms_certified, mut certify_s) = (None, None, None);
+        if m <= certify_up_to {
+            let t1 = Instant::now();
+            let opts = Options {
+                meta_level: true,
+                ..Options::lattice_only()
+            };
+            meta_certified = Some(certify::certify(&whole, &opts)?.certified);
+            let ca = certify::certify(&a, &Options::lattice_only())?.certified;
+            let cb = certify::certify(&b, &Options::lattice_only())?.certified;
+            atoms_certified = Some(ca && cb);
+            certify_s = Some(t1.elapsed().as_secs_f64());
+        }
+        let count = |s: &crate::schedule::Schedule| -> usize {
+            s.steps.iter().map(|st| st.events.len()).sum()
+        };
+        rows.push(TheoremRow {
+            metas: m,
+            atoms: 8 * m,
+            phase_steps: std::array::from_fn(|i| plan.phases[i].len()),
+            tunnels,
+            short_tunnels: short,
+            longest_leg: longest,
+            comb_steps: a.steps.len() + b.steps.len(),
+            comb_operations: count(&a) + count(&b),
+            meta_certified,
+            atoms_certified,
+            generate_s,
+            certify_s,
+        });
+    }
+    Ok(rows)
+}
+
+/// Theorem 1's series against atoms n: meta-module steps of the whole
+/// reconfiguration, tunnels, and the combing phases' parallel steps and
+/// atom operations.
+pub fn theorem_series(rows: &[TheoremRow]) -> [(&'static str, Vec<(f64, f64)>); 4] {
+    let pts = |f: fn(&TheoremRow) -> usize| -> Vec<(f64, f64)> {
+        rows.iter().map(|r| (r.atoms as f64, f(r) as f64)).collect()
+    };
+    [
+        (
+            "meta-module steps, S to T",
+            pts(|r| r.phase_steps.iter().sum()),
+        ),
+        ("tunnels", pts(|r| r.tunnels.iter().sum())),
+        ("combing phases' parallel steps", pts(|r| r.comb_steps)),
+        (
+            "combing phases' atom operations",
+            pts(|r| r.comb_operations),
+        ),
+    ]
+}
+
 /// Least-squares fit of `ln y = a + b·ln x` (slope `b`, intercept `a`,
 /// R² in log space): the power law `y = eᵃ·xᵇ`. Points with a
 /// non-positive coordinate are left out.

@@ -166,6 +166,47 @@ proptest! {
     }
 }
 
+/// A small Theorem 1 schedule of seed 004 (tunnels, slides, latches).
+fn theorem_1_original() -> Value {
+    use rand::SeedableRng;
+    use reconfcheck::algorithms::comb::common_comb::reconfigure;
+    use reconfcheck::algorithms::comb::{meta_schedule_framed, random_polyomino};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let (a, b) = (random_polyomino(7, &mut rng), random_polyomino(7, &mut rng));
+    let plan = reconfigure(&a, &b);
+    let s = meta_schedule_framed(
+        &a,
+        &plan.steps(),
+        reconfcheck::lattice::AtomRest::Contracted,
+        None,
+    );
+    serde_json::from_str(&s.to_json()).unwrap()
+}
+
+proptest! {
+    #![proptest_config(config(256))]
+
+    #[test]
+    fn edited_meta_module_schedules_are_refused_or_certified_at_meta_level_never_a_panic(
+        edits in prop::collection::vec((0usize..3, any::<prop::sample::Index>(), 0usize..64), 1..4),
+    ) {
+        let v = edits
+            .into_iter()
+            .fold(theorem_1_original(), |v, (what, pick, with)| mutate(v, what, pick, with));
+        let text = serde_json::to_string(&v).unwrap();
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            let s = Schedule::from_json(&text, Path::new("edited.json"))?;
+            let opts = Options { meta_level: true, ..Default::default() };
+            certify(&s, &opts).map(|r| r.certified).map_err(|e| e.in_file("edited.json"))
+        }));
+        match outcome {
+            Ok(Ok(_)) => {}
+            Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.json"), "{e}"),
+            Err(_) => prop_assert!(false, "panicked on {text}"),
+        }
+    }
+}
+
 /// Pieces that CSG and grid files are made of, and some that break them.
 const PIECES: &[&str] = &[
     "(",
@@ -338,6 +379,7 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
             "active-subtraction",
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),
+        ("comb-2d", "metas = 6\nseed = 1\nuntil = \"target\""),
         (
             "active-subtraction",
             "mode = \"sas\"\n[random]\nwidth = 4\nheight = 4\ndensity = 0.5\nseed = 2\ngrowth = \"chain\"",

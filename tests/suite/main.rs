@@ -12,6 +12,7 @@ mod architecture;
 mod browser;
 mod ci_gate;
 mod cli;
+mod comb_theorem;
 mod cube_atoms;
 mod docking;
 mod edges;

@@ -1,14 +1,19 @@
 //! Seed 004 in 2D (Aloupis et al., §3.1): the source robot of 2×2×2
-//! meta-modules is combed (Algorithm 1, the wall sweep). The rest of
-//! Theorem 1 (COMB-TO-COMMON-COMB and the target's reverse) needs k-TUNNEL,
-//! which this build has not derived at atom level: not generated.
+//! meta-modules is combed (Algorithm 1, the wall sweep), and with
+//! `until = "target"` made the common comb (Algorithm 2) and then the
+//! target by the target's own two phases in reverse (Theorem 1,
+//! [`common_comb`]).
 //!
 //! The generator works on meta-modules (cells of the coarse cubic lattice,
 //! `z = 0`) and writes a `meta_modules` schedule: `slide` (the paper's
 //! SLIDE, carrying whatever is attached to the slider; `pivot` is the wall
 //! meta-module B; carried meta-modules get a `slide` without pivot),
-//! `attach` and `detach` of whole meta-modules. The certifier expands that
-//! schedule into atom operations.
+//! `tunnel` (k-TUNNEL along an orthogonal path), `attach` and `detach` of
+//! whole meta-modules. The certifier expands that schedule into atom
+//! operations where every move has a derived atom sequence, and certifies
+//! it at the meta-module level otherwise (`certify --meta-level`).
+
+pub mod common_comb;
 
 use super::{Generator, parameters};
 use crate::error::InputError;
@@ -37,11 +42,11 @@ pub struct Robot {
     pub steps: Vec<Vec<Event>>,
 }
 
-fn pair(a: usize, b: usize) -> (usize, usize) {
+pub(crate) fn pair(a: usize, b: usize) -> (usize, usize) {
     if a < b { (a, b) } else { (b, a) }
 }
 
-fn cell(c: (i32, i32)) -> Cell {
+pub(crate) fn cell(c: (i32, i32)) -> Cell {
     Cell::new(c.0, c.1, 0)
 }
 
@@ -71,7 +76,7 @@ impl Robot {
         self.by_cell.get(&c).copied()
     }
 
-    fn relocate(&mut self, moves: &[(usize, (i32, i32))]) {
+    pub(crate) fn relocate(&mut self, moves: &[(usize, (i32, i32))]) {
         for &(k, _) in moves {
             self.by_cell.remove(&self.at[k]);
         }
@@ -315,14 +320,37 @@ pub fn parse_picture(text: &str) -> BTreeSet<(i32, i32)> {
     out
 }
 
-/// A meta-module schedule of the robot's recorded steps.
+/// A meta-module schedule of the robot's recorded steps, the frame the
+/// leftmost meta-module of the lowest row (which neither the combing nor
+/// the comb-to-common-comb moves).
 pub fn meta_schedule(start: &Shape, steps: &[Vec<Event>], rest: AtomRest) -> Schedule {
+    let anchor = start.iter().min_by_key(|c| (c.1, c.0)).copied();
+    meta_schedule_framed(start, steps, rest, anchor)
+}
+
+/// [`meta_schedule`] with the frame the meta-module at `anchor` (none:
+/// no meta-module fixed; the robot must then stay one piece).
+pub fn meta_schedule_framed(
+    start: &Shape,
+    steps: &[Vec<Event>],
+    rest: AtomRest,
+    anchor: Option<(i32, i32)>,
+) -> Schedule {
+    let at: Vec<(i32, i32)> = start.iter().copied().collect();
+    meta_schedule_at(&at, steps, rest, anchor)
+}
+
+/// [`meta_schedule_framed`] from meta-module `k` at `at[k]` (a robot in the
+/// middle of a run, its ids kept).
+pub fn meta_schedule_at(
+    at: &[(i32, i32)],
+    steps: &[Vec<Event>],
+    rest: AtomRest,
+    anchor: Option<(i32, i32)>,
+) -> Schedule {
     let mut s = Schedule::new(LatticeKind::Cubic, Length::mm(120.0));
     s.meta_modules = Some(rest);
-    // The frame: the leftmost meta-module of the lowest row, which neither
-    // the combing nor the comb-to-common-comb moves.
-    let anchor = start.iter().min_by_key(|c| (c.1, c.0)).copied();
-    s.modules = start
+    s.modules = at
         .iter()
         .enumerate()
         .map(|(k, &c)| ModuleSpec {
@@ -353,6 +381,24 @@ pub struct CombParams {
     /// The atoms' rest model: `"contracted"` (default) or `"expanded"`.
     #[serde(default = "default_rest")]
     pub model: AtomRest,
+    /// How far to go (see [`Until`]).
+    #[serde(default)]
+    pub until: Until,
+}
+
+/// How far the `comb-2d` generator takes the source.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Until {
+    /// The source's comb (Algorithm 1): SLIDEs and latches only, every one
+    /// with a derived atom sequence, so the certifier checks every atom.
+    #[default]
+    Comb,
+    /// The target (Theorem 1): the comb, the common comb, and the target's
+    /// phases reversed. Its k-TUNNELs have legs longer than one
+    /// meta-module, which have no derived atom sequence: such a schedule
+    /// is certified at the meta-module level (`certify --meta-level`).
+    Target,
 }
 
 fn default_metas() -> usize {
@@ -411,14 +457,31 @@ impl Generator for Comb2d {
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
         let p: CombParams = parameters(scenario)?;
         let (src, tgt) = shapes(scenario, &p)?;
-        // The target is read and checked (2×2 blocks, connected, same
-        // count) but not yet reached: COMB-TO-COMMON-COMB and the reverse
-        // need k-TUNNEL at atom level (docs/atoms.md).
-        let _ = tgt;
-        let mut r = Robot::new(&src);
-        r.comb();
-        let steps = r.steps;
-        let mut s = meta_schedule(&src, &steps, p.model);
+        let mut s = match p.until {
+            Until::Comb => {
+                let mut r = Robot::new(&src);
+                r.comb();
+                meta_schedule(&src, &r.steps, p.model)
+            }
+            Until::Target => {
+                let plan = common_comb::reconfigure(&src, &tgt);
+                let lowest = |s: &Shape| -> BTreeSet<(i32, i32)> {
+                    let y0 = s.iter().map(|c| c.1).min().unwrap_or(0);
+                    s.iter().copied().filter(|c| c.1 == y0).collect()
+                };
+                // The frame: a meta-module in the lowest row of both, which
+                // no phase moves; else none (the robot must stay one piece).
+                let anchor = lowest(&src)
+                    .intersection(&lowest(&plan.target))
+                    .next()
+                    .copied();
+                let mut s = meta_schedule_framed(&src, &plan.steps(), p.model, anchor);
+                let phases: Vec<serde_json::Value> =
+                    plan.phases.iter().map(|ph| ph.len().into()).collect();
+                s.meta.insert("phase_steps".into(), phases.into());
+                s
+            }
+        };
         s.meta.insert("algorithm".into(), "comb-2d".into());
         s.meta.insert("meta_modules".into(), src.len().into());
         s.meta.insert("seed".into(), p.seed.into());
