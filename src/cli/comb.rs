@@ -7,7 +7,7 @@
 use reconfcheck::algorithms::atom_moves::derive_slide;
 use reconfcheck::error::{Error, write_file};
 use reconfcheck::geometry::atom_expand::tunnel_library;
-use reconfcheck::geometry::atom_search::Carry;
+use reconfcheck::geometry::atom_search::{Carry, Legs};
 use reconfcheck::lattice::AtomRest;
 use reconfcheck::study::comb as study;
 use std::path::PathBuf;
@@ -57,18 +57,19 @@ pub fn run(a: Args) -> Result<u8, Error> {
             }
         }
     }
-    match tunnel_library(AtomRest::Contracted) {
-        Some(t) => println!(
-            "1-TUNNEL, contracted (a leaf through one turn, legs of one meta-module; paper: O(1)): {} steps, {} ops, {} states",
-            t.steps.len(),
-            t.atom_operations(),
-            t.found.states_explored
-        ),
-        None => println!("1-TUNNEL, contracted: not found"),
+    for legs in Legs::ALL {
+        match tunnel_library(AtomRest::Contracted, legs) {
+            Some(t) => println!(
+                "1-TUNNEL, contracted, {} (legs of any length; paper: O(1)): {} steps, {} ops, {} states",
+                legs.name(),
+                t.steps.len(),
+                t.atom_operations(),
+                t.found.states_explored
+            ),
+            None => println!("1-TUNNEL, contracted, {}: not found", legs.name()),
+        }
     }
-    println!(
-        "k-TUNNEL for k > 1, with longer legs, and in the expanded model: not derived (see docs/atoms.md)"
-    );
+    println!("k-TUNNEL for k > 1 and in the expanded model: not derived (see docs/atoms.md)");
     let mut all = Vec::new();
     // The expanded model has no derived SLIDE (docs/atoms.md).
     for rest in [AtomRest::Contracted] {
@@ -120,7 +121,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
     }
     let theorem = study::theorem(&a.sizes, a.seed, AtomRest::Contracted, a.certify_up_to)?;
     println!(
-        "\nTHEOREM 1 in 2D, Contracted model (random source and target, seed {}): meta-module steps per phase\n(comb S | S to common comb | common comb to comb T, latches first | comb T to T), tunnels by turns,\nthose with every leg of one (derived at atom level), the longest leg; the combing phases expanded into atoms",
+        "\nTHEOREM 1 in 2D, Contracted model (random source and target, seed {}): meta-module steps per phase\n(comb S | S to common comb | common comb to comb T, latches first | comb T to T), tunnels by turns,\nthose with every leg of one, the longest leg; the combing phases expanded into atoms (1-TUNNELs have a derived atom sequence, 2-TUNNELs not)",
         a.seed
     );
     println!(

@@ -88,8 +88,9 @@ fn library(
     .as_ref()
 }
 
-/// The derived 1-TUNNEL ([`tunnel_problem`] without legs), lifted to 3D.
+/// A derived 1-TUNNEL ([`tunnel_problem`] with its legs), lifted to 3D.
 pub struct TunnelLibrary {
+    pub legs: Legs,
     pub problem: Problem,
     pub found: Found,
     /// The 2D slice at the end of the move (where each atom ends up).
@@ -105,31 +106,31 @@ impl TunnelLibrary {
     }
 }
 
-/// Bound of the 1-TUNNEL search (states); the contracted model's move is
-/// found after about 220,000.
+/// Bound of the 1-TUNNEL searches (states, both directions together); the
+/// contracted model's moves are found within about 720,000.
 pub const TUNNEL_MAX_STATES: usize = 3_000_000;
 
-/// The 1-TUNNEL of the contracted model, searched once per process; `None`
+/// The 1-TUNNEL of the contracted model with `legs` (a leg meta-module
+/// behind the leaf A, one between the turn and the exit: each stands for
+/// a leg of any length, whose further meta-modules ride rigidly),
+/// searched once per process ([`Problem::solve_bidirectional`]); `None`
 /// for the expanded model (not derived: see `docs/atoms.md`).
-pub fn tunnel_library(rest: AtomRest) -> Option<&'static TunnelLibrary> {
-    static CONTRACTED: OnceLock<Option<TunnelLibrary>> = OnceLock::new();
+pub fn tunnel_library(rest: AtomRest, legs: Legs) -> Option<&'static TunnelLibrary> {
+    static CONTRACTED: [OnceLock<Option<TunnelLibrary>>; 4] = [const { OnceLock::new() }; 4];
     if rest != AtomRest::Contracted {
         return None;
     }
-    CONTRACTED
+    CONTRACTED[usize::from(legs.behind) + 2 * usize::from(legs.ahead)]
         .get_or_init(|| {
-            let legs = Legs {
-                behind: false,
-                ahead: false,
-            };
             let (problem, _) = tunnel_problem(rest, legs);
-            let found = problem.solve_guided(2, TUNNEL_MAX_STATES)?;
+            let found = problem.solve_bidirectional(2, TUNNEL_MAX_STATES)?;
             let mut end = problem.start.clone();
             for st in &found.steps {
                 end = end.step(st, &problem.anchors, problem.eps)?;
             }
             let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
             Some(TunnelLibrary {
+                legs,
                 problem,
                 found,
                 end,
@@ -239,89 +240,125 @@ fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
     )
 }
 
-/// A 1-TUNNEL placed in the robot: the turn B, the static neighbour L
-/// opposite the exit, the exit cell, and the symmetry's canonical −x and −y.
+/// A 1-TUNNEL placed in the robot: the library of its legs, the scene's
+/// meta-modules (L, B, A, then D and E where the legs are longer), the
+/// symmetry's canonical −x and −y, and each path cell with the
+/// meta-module in it (the exit last, empty).
 struct PlacedTunnel {
     lib: &'static TunnelLibrary,
-    b: ModuleId,
-    l: ModuleId,
-    exit: Cell,
+    ids: Vec<ModuleId>,
     d: Cell,
     w: Cell,
+    path: Vec<(Cell, Option<ModuleId>)>,
+    turn: usize,
 }
 
-/// Checks that a `tunnel` event is the derived 1-TUNNEL: a path `[A, B,
-/// exit]` with one turn, A a leaf on B, B held only by A and by L on the
-/// side opposite the exit, the exit and the corner between the two legs
-/// free. Anything else is refused with the reason.
+/// Checks that a `tunnel` event is a derived 1-TUNNEL: a path of
+/// neighbouring cells with one turn B, its cells occupied up to a free
+/// exit, B held by L on the side opposite the exit and touched by nothing
+/// else, and the corner between the two legs free. The legs may be of any
+/// length (their further meta-modules ride rigidly on the scene's D and
+/// E); whether anything else holds them is the certifier's to find.
+/// Anything else is refused with the reason.
 fn one_tunnel(
     here: Cell,
     path: &[Cell],
     by_cell: &FxHashMap<Cell, ModuleId>,
     rest: AtomRest,
 ) -> Result<PlacedTunnel, String> {
-    let [a, b, c] = path else {
+    if path.len() < 3 {
         return Err(format!(
-            "only 1-TUNNEL with legs of one meta-module is derived (a path of 3 cells), not a path of {} cells",
+            "a 1-TUNNEL path has at least 3 cells, not {}",
             path.len()
         ));
+    }
+    if path[0] != here {
+        return Err(format!(
+            "the tunnel starts at {}, but the meta-module is at {here}",
+            path[0]
+        ));
+    }
+    if let Some(w) = path.windows(2).find(|w| (w[1] - w[0]).l1() != 1) {
+        return Err(format!(
+            "a tunnel path steps between neighbouring cells; {} and {} are not",
+            w[0], w[1]
+        ));
+    }
+    let turns: Vec<usize> = (1..path.len() - 1)
+        .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
+        .collect();
+    let [t] = turns[..] else {
+        return Err(format!(
+            "only the 1-TUNNEL (one turn) is derived; this path turns {} times",
+            turns.len()
+        ));
     };
-    if *a != here {
-        return Err(format!(
-            "the tunnel starts at {a}, but the meta-module is at {here}"
-        ));
+    let (b, up, out) = (path[t], path[t - 1] - path[t], path[t + 1] - path[t]);
+    if up.x * out.x + up.y * out.y + up.z * out.z != 0 {
+        return Err(format!("the path turns back on itself at {b}"));
     }
-    let (up, out) = (*a - *b, *c - *b);
-    if up.l1() != 1 || out.l1() != 1 || up.x * out.x + up.y * out.y + up.z * out.z != 0 {
-        return Err(format!(
-            "a 1-TUNNEL path turns once between neighbouring cells; {a}, {b}, {c} do not"
-        ));
+    let exit = *path.last().expect("long enough");
+    let mut cells = Vec::with_capacity(path.len());
+    for &c in &path[..path.len() - 1] {
+        let m = *by_cell.get(&c).ok_or_else(|| {
+            format!("the tunnel path runs through {c}, where there is no meta-module")
+        })?;
+        cells.push((c, Some(m)));
     }
-    let turn_id = *by_cell
-        .get(b)
-        .ok_or_else(|| format!("the tunnel turns at {b}, where there is no meta-module"))?;
-    let behind = *b - out;
+    cells.push((exit, None));
+    let behind = b - out;
     let l = *by_cell.get(&behind).ok_or_else(|| {
         format!("the turn {b} must hang on a meta-module at {behind}, opposite the exit")
     })?;
-    for (cell, what) in [(*c, "the exit"), (*c + up, "the corner between the legs")] {
+    for (cell, what) in [
+        (exit, "the exit"),
+        (b + up + out, "the corner between the legs"),
+    ] {
         if let Some(o) = by_cell.get(&cell) {
             return Err(format!("{what} {cell} is taken by meta-module {o}"));
         }
     }
-    let dirs = Face::ALL.map(|f| f.dir());
-    for n in dirs.iter().map(|&v| *a + v).filter(|n| n != b) {
-        if let Some(o) = by_cell.get(&n) {
-            return Err(format!(
-                "the tunnelling meta-module must be a leaf on the turn; meta-module {o} at {n} touches it"
-            ));
-        }
-    }
-    for n in dirs
-        .iter()
-        .map(|&v| *b + v)
-        .filter(|n| n != a && *n != behind)
+    for n in Face::ALL
+        .map(|f| b + f.dir())
+        .into_iter()
+        .filter(|&n| n != path[t - 1] && n != path[t + 1] && n != behind)
     {
         if let Some(o) = by_cell.get(&n) {
             return Err(format!(
-                "the turn {b} may touch only the tunnelling meta-module and the one opposite the exit; meta-module {o} at {n} touches it"
+                "the turn {b} may touch only the path and the meta-module opposite the exit; meta-module {o} at {n} touches it"
             ));
         }
     }
+    let legs = Legs {
+        behind: t >= 2,
+        ahead: t + 2 < path.len(),
+    };
     // Searched last, and once per process: refusals above cost nothing.
-    let lib = tunnel_library(rest).ok_or_else(|| {
+    let lib = tunnel_library(rest, legs).ok_or_else(|| {
         format!(
-            "no atom sequence for 1-TUNNEL was derived in the {} model",
+            "no atom sequence for 1-TUNNEL ({}) was derived in the {} model",
+            legs.name(),
             format!("{rest:?}").to_lowercase()
         )
     })?;
+    let mut ids = vec![
+        l,
+        cells[t].1.expect("occupied"),
+        cells[t - 1].1.expect("occupied"),
+    ];
+    if legs.behind {
+        ids.push(cells[t - 2].1.expect("occupied"));
+    }
+    if legs.ahead {
+        ids.push(cells[t + 1].1.expect("occupied"));
+    }
     Ok(PlacedTunnel {
         lib,
-        b: turn_id,
-        l,
-        exit: *c,
+        ids,
         d: Cell::ZERO - out,
         w: Cell::ZERO - up,
+        path: cells,
+        turn: t,
     })
 }
 
@@ -374,7 +411,7 @@ fn expand_tracked(
         let mut moved: Vec<(ModuleId, Cell)> = Vec::new();
         let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
             FxHashMap::default();
-        let mut retag: Vec<(ModuleId, [ModuleId; 8], ModuleId, [ModuleId; 8])> = Vec::new();
+        let mut retag: Vec<(ModuleId, [ModuleId; 8])> = Vec::new();
         let mut wall_cells: FxHashMap<ModuleId, Cell> = FxHashMap::default();
         for e in &step.events {
             let id = e.module();
@@ -440,8 +477,7 @@ fn expand_tracked(
                     let t = one_tunnel(here, path, &by_cell, rest).map_err(err)?;
                     let lib = t.lib;
                     let turn = Turn::new(t.d, t.w);
-                    let ids = [t.l, t.b, id];
-                    let atom = |q: usize| lifted_atom(q, &ids, &turn, &owner);
+                    let atom = |q: usize| lifted_atom(q, &t.ids, &turn, &owner);
                     slides.push(
                         lib.steps
                             .iter()
@@ -452,23 +488,37 @@ fn expand_tracked(
                             })
                             .collect(),
                     );
-                    // Where each atom of B and A ends: B's cell keeps B, the
-                    // exit cell is A's.
-                    let mut ob = owner[&t.b];
-                    let mut oa = owner[&id];
-                    for q in 8..24 {
+                    // Whose atoms each path cell holds at the end: the
+                    // scene's where the search left them, the further leg
+                    // meta-modules' one cell along the path; each cell
+                    // keeps its meta-module but the leaf's, whose is the
+                    // exit.
+                    let b = t.path[t.turn].0;
+                    let mut new: FxHashMap<Cell, [ModuleId; 8]> = FxHashMap::default();
+                    for q in 0..lib.end.pos.len() * 2 {
                         let e = lib.end.pos[q / 2];
-                        let k = (q % 2) as i32;
-                        let to = turn.local(e.x.rem_euclid(2), e.y.rem_euclid(2), k) as usize;
-                        let a = atom(q);
-                        if e.x.div_euclid(2) == 0 {
-                            ob[to] = a;
-                        } else {
-                            oa[to] = a;
-                        }
+                        let cell =
+                            b + turn.apply(Cell::new(e.x.div_euclid(2), e.y.div_euclid(2), 0));
+                        let to = turn.local(e.x.rem_euclid(2), e.y.rem_euclid(2), (q % 2) as i32);
+                        new.entry(cell).or_insert([0; 8])[to as usize] = atom(q);
                     }
-                    retag.push((t.b, ob, id, oa));
-                    moved.push((id, t.exit));
+                    let far = |i: usize| i + 2 < t.turn || (i > t.turn + 1 && i + 1 < t.path.len());
+                    for i in (0..t.path.len() - 1).filter(|&i| far(i)) {
+                        let m = t.path[i].1.expect("occupied");
+                        new.insert(t.path[i + 1].0, owner[&m]);
+                    }
+                    for (k, &(cell, m)) in t.path.iter().enumerate().skip(1) {
+                        let m = if k + 1 == t.path.len() {
+                            id
+                        } else {
+                            m.expect("occupied")
+                        };
+                        let atoms = *new
+                            .get(&cell)
+                            .ok_or_else(|| err(format!("the tunnel leaves {cell} empty")))?;
+                        retag.push((m, atoms));
+                    }
+                    moved.push((id, t.path.last().expect("a path").0));
                 }
                 _ => {
                     return Err(err(
@@ -563,9 +613,8 @@ fn expand_tracked(
                 .collect();
             out.steps.push(Step { events });
         }
-        for (b, ob, a, oa) in retag {
-            owner.insert(b, ob);
-            owner.insert(a, oa);
+        for (m, atoms) in retag {
+            owner.insert(m, atoms);
         }
         for &(id, _) in &moved {
             by_cell.remove(&at[&id]);
@@ -647,44 +696,78 @@ mod tests {
     fn after_a_tunnel_each_meta_module_is_the_atoms_in_its_cell() {
         // L2 (fixed), L, the turn B, the leaf A on B, G on L2; A tunnels
         // through B to the exit (1, 0, 0), turned so that the slice is
-        // lifted along y.
+        // lifted along y. Then the same with long legs: an in-leg of three
+        // (A, D, D2 the leaf) and an out-leg E, E2 before the exit.
         let m = |id: ModuleId, c: [i32; 3]| ModuleSpec {
             id,
             cell: Cell::new(c[0], c[1], c[2]),
             fixed: id == 0,
         };
-        let mut s = Schedule::new(
-            crate::lattice::LatticeKind::Cubic,
-            crate::schedule::Length::mm(60.0),
+        let cells = |p: &[[i32; 3]]| {
+            p.iter()
+                .map(|c| Cell::new(c[0], c[1], c[2]))
+                .collect::<Vec<Cell>>()
+        };
+        let short = (
+            vec![
+                m(0, [-2, 0, 0]),
+                m(1, [-1, 0, 0]),
+                m(2, [0, 0, 0]),
+                m(3, [0, 0, 1]),
+                m(4, [-2, 0, 1]),
+            ],
+            3,
+            cells(&[[0, 0, 1], [0, 0, 0], [1, 0, 0]]),
         );
-        s.meta_modules = Some(AtomRest::Contracted);
-        s.modules = vec![
-            m(0, [-2, 0, 0]),
-            m(1, [-1, 0, 0]),
-            m(2, [0, 0, 0]),
-            m(3, [0, 0, 1]),
-            m(4, [-2, 0, 1]),
-        ];
-        s.steps = vec![Step {
-            events: vec![Event::Tunnel {
-                module: 3,
-                path: vec![Cell::new(0, 0, 1), Cell::new(0, 0, 0), Cell::new(1, 0, 0)],
-            }],
-        }];
-        let (atoms, owners, at) = expand_tracked(&s, AtomRest::Contracted).unwrap();
-        assert_eq!(at[&3], Cell::new(1, 0, 0));
-        assert_eq!(at[&2], Cell::new(0, 0, 0));
-        let end = replay(&atoms);
-        let mut exchanged = 0;
-        for (id, own) in &owners {
-            for (l, a) in own.iter().enumerate() {
-                let want = atoms_of(*id, at[id], 1).nth(l).unwrap().cell;
-                assert_eq!(end[a], want, "meta-module {id}, local atom {l}");
-                exchanged += (*a / 8 != *id) as usize;
+        let long = (
+            vec![
+                m(0, [-2, 0, 0]),
+                m(1, [-1, 0, 0]),
+                m(2, [0, 0, 0]),
+                m(3, [0, 0, 1]),
+                m(4, [0, 0, 2]),
+                m(5, [0, 0, 3]),
+                m(6, [1, 0, 0]),
+                m(7, [2, 0, 0]),
+            ],
+            5,
+            cells(&[
+                [0, 0, 3],
+                [0, 0, 2],
+                [0, 0, 1],
+                [0, 0, 0],
+                [1, 0, 0],
+                [2, 0, 0],
+                [3, 0, 0],
+            ]),
+        );
+        for (k, (modules, leaf, path)) in [short, long].into_iter().enumerate() {
+            let mut s = Schedule::new(
+                crate::lattice::LatticeKind::Cubic,
+                crate::schedule::Length::mm(60.0),
+            );
+            s.meta_modules = Some(AtomRest::Contracted);
+            s.modules = modules;
+            let exit = *path.last().unwrap();
+            s.steps = vec![Step {
+                events: vec![Event::Tunnel { module: leaf, path }],
+            }];
+            let (atoms, owners, at) = expand_tracked(&s, AtomRest::Contracted).unwrap();
+            assert_eq!(at[&leaf], exit);
+            assert_eq!(at[&2], Cell::new(0, 0, 0));
+            let end = replay(&atoms);
+            let mut exchanged = 0;
+            for (id, own) in &owners {
+                for (l, a) in own.iter().enumerate() {
+                    let want = atoms_of(*id, at[id], 1).nth(l).unwrap().cell;
+                    assert_eq!(end[a], want, "case {k}: meta-module {id}, local atom {l}");
+                    exchanged += (*a / 8 != *id) as usize;
+                }
             }
+            // The derived moves exchange atoms between A and B, and the
+            // legs' atoms move one cell along (docs/atoms.md).
+            assert!(exchanged > 0);
         }
-        // The derived move exchanges atoms between A and B (docs/atoms.md).
-        assert!(exchanged > 0);
     }
 
     #[test]

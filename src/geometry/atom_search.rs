@@ -119,8 +119,21 @@ impl Scene {
     /// atom of it the index it had here: the form in which permutations of
     /// identical atoms are one state.
     pub fn canonical(&self) -> (Scene, Vec<usize>) {
+        self.canonical_in(&[(0..self.pos.len()).collect()])
+    }
+
+    /// [`Scene::canonical`] within each group of identical atoms (ascending
+    /// indices): a group's atoms are sorted among the group's own indices,
+    /// the atoms of no group keep theirs.
+    pub fn canonical_in(&self, groups: &[Vec<usize>]) -> (Scene, Vec<usize>) {
         let mut idx: Vec<usize> = (0..self.pos.len()).collect();
-        idx.sort_by_key(|&i| ((self.pos[i].x, self.pos[i].y, self.pos[i].z), self.ext[i]));
+        for g in groups {
+            let mut v = g.clone();
+            v.sort_by_key(|&i| ((self.pos[i].x, self.pos[i].y, self.pos[i].z), self.ext[i]));
+            for (&k, &i) in g.iter().zip(&v) {
+                idx[k] = i;
+            }
+        }
         let mut inv = vec![0; idx.len()];
         for (k, &i) in idx.iter().enumerate() {
             inv[i] = k;
@@ -135,6 +148,55 @@ impl Scene {
                 .collect(),
         };
         (scene, idx)
+    }
+
+    /// A compact key of the scene (four bytes an atom, then a bit per
+    /// atom pair), for searches that keep millions of states. Coordinates
+    /// must lie in −64 … 191.
+    pub fn key(&self) -> Box<[u8]> {
+        let n = self.pos.len();
+        let mut out = vec![0u8; 4 * n + (n * n.saturating_sub(1) / 2).div_ceil(8)];
+        for a in 0..n {
+            let p = self.pos[a];
+            for (k, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+                out[4 * a + k] = u8::try_from(v + 64).expect("coordinates in −64 … 191");
+            }
+            out[4 * a + 3] = self.ext[a]
+                .iter()
+                .enumerate()
+                .fold(0, |m, (i, &e)| m | (u8::from(e) << i));
+        }
+        for &(a, b) in &self.bonds {
+            let p = b * (b - 1) / 2 + a;
+            out[4 * n + p / 8] |= 1 << (p % 8);
+        }
+        out.into_boxed_slice()
+    }
+
+    /// The scene of a [`Scene::key`] of `n` atoms.
+    pub fn from_key(k: &[u8], n: usize) -> Scene {
+        let pos = (0..n)
+            .map(|a| {
+                Cell::new(
+                    k[4 * a] as i32 - 64,
+                    k[4 * a + 1] as i32 - 64,
+                    k[4 * a + 2] as i32 - 64,
+                )
+            })
+            .collect();
+        let ext = (0..n)
+            .map(|a| std::array::from_fn(|i| k[4 * a + 3] & (1 << i) != 0))
+            .collect();
+        let mut bonds = BTreeSet::new();
+        for b in 1..n {
+            for a in 0..b {
+                let p = b * (b - 1) / 2 + a;
+                if k[4 * n + p / 8] & (1 << (p % 8)) != 0 {
+                    bonds.insert((a, b));
+                }
+            }
+        }
+        Scene { pos, ext, bonds }
     }
 
     fn bond_list(&self) -> Vec<Bond> {
@@ -266,11 +328,14 @@ pub struct Problem {
     /// Where bodies and arms may be (atom cells of the 2D slice), when the
     /// move must stay inside given room (a k-TUNNEL's in-place claim).
     pub room: Option<FxHashSet<Cell>>,
-    /// Atoms are interchangeable: a state is its occupied cells, faces and
-    /// bonds, whichever atom is where (`solve_guided` only). The found
+    /// Groups of interchangeable atoms (ascending indices; empty: every
+    /// atom told apart): a state is, within each group, its occupied
+    /// cells, faces and bonds, whichever of the group's atoms is where
+    /// (`solve_guided` and `solve_bidirectional` only). A group's atoms
+    /// must all act or all not (the actors are indices). The found
     /// operations name the start's atoms; the goal is met by any
-    /// assignment of atoms to its cells.
-    pub exchange: bool,
+    /// assignment of a group's atoms to the group's goal cells.
+    pub exchange: Vec<Vec<usize>>,
 }
 
 /// A found sequence: single operations in order, and packed into steps.
@@ -330,7 +395,7 @@ impl Problem {
                 return false;
             }
         }
-        if self.exchange {
+        if !self.exchange.is_empty() {
             // Atom indices name places in a canonical order, not atoms.
             return true;
         }
@@ -396,37 +461,9 @@ impl Problem {
     pub fn solve_guided(&self, weight: usize, max_states: usize) -> Option<Found> {
         use std::cmp::Reverse;
         use std::collections::BinaryHeap;
-        let canon = |s: Scene| if self.exchange { s.canonical().0 } else { s };
+        let canon = |s: Scene| self.canon(s);
         let goal = canon(self.goal.clone());
-        let goal_cells: BTreeSet<Cell> = goal.pos.iter().copied().collect();
-        let h = |s: &Scene| -> usize {
-            if self.exchange {
-                // Each misplaced atom's distance to the nearest free goal cell.
-                let occ: BTreeSet<Cell> = s.pos.iter().copied().collect();
-                let free: Vec<Cell> = goal_cells.difference(&occ).copied().collect();
-                return s
-                    .pos
-                    .iter()
-                    .filter(|c| !goal_cells.contains(c))
-                    .map(|c| free.iter().map(|g| (*g - *c).l1()).min().unwrap_or(0) as usize)
-                    .sum::<usize>()
-                    + s.ext
-                        .iter()
-                        .flatten()
-                        .filter(|&&x| x != goal.ext[0][0])
-                        .count();
-            }
-            s.pos
-                .iter()
-                .zip(&self.goal.pos)
-                .map(|(p, g)| (*p - *g).l1() as usize)
-                .sum::<usize>()
-                + s.ext
-                    .iter()
-                    .zip(&self.goal.ext)
-                    .map(|(e, g)| e.iter().zip(g).filter(|(x, y)| x != y).count())
-                    .sum::<usize>()
-        };
+        let h = |s: &Scene| self.distance(s, &goal);
         let mut parent: FxHashMap<Scene, Option<(usize, Op)>> = FxHashMap::default();
         let start = canon(self.start.clone());
         let mut states = vec![start.clone()];
@@ -443,7 +480,7 @@ impl Problem {
                     cur = prev;
                 }
                 ops.reverse();
-                if self.exchange {
+                if !self.exchange.is_empty() {
                     ops = self.name_atoms(&ops);
                 }
                 let steps = self.pack(&ops);
@@ -480,14 +517,179 @@ impl Problem {
         None
     }
 
+    /// The state as the search keeps it: canonical within the exchange
+    /// groups.
+    fn canon(&self, s: Scene) -> Scene {
+        if self.exchange.is_empty() {
+            s
+        } else {
+            s.canonical_in(&self.exchange).0
+        }
+    }
+
+    /// The search's heuristic from `s` to `target` (both canonical): each
+    /// atom's L1 distance to its target cell, or with exchange each
+    /// misplaced atom's distance to the nearest free target cell of its
+    /// group; plus the faces whose state differs.
+    fn distance(&self, s: &Scene, target: &Scene) -> usize {
+        let faces: usize = s
+            .ext
+            .iter()
+            .zip(&target.ext)
+            .map(|(e, g)| e.iter().zip(g).filter(|(x, y)| x != y).count())
+            .sum();
+        if self.exchange.is_empty() {
+            return faces
+                + s.pos
+                    .iter()
+                    .zip(&target.pos)
+                    .map(|(p, g)| (*p - *g).l1() as usize)
+                    .sum::<usize>();
+        }
+        let mut sum = faces;
+        let grouped: FxHashSet<usize> = self.exchange.iter().flatten().copied().collect();
+        for a in (0..s.pos.len()).filter(|a| !grouped.contains(a)) {
+            sum += (s.pos[a] - target.pos[a]).l1() as usize;
+        }
+        for g in &self.exchange {
+            let want: BTreeSet<Cell> = g.iter().map(|&i| target.pos[i]).collect();
+            let have: BTreeSet<Cell> = g.iter().map(|&i| s.pos[i]).collect();
+            let free: Vec<Cell> = want.difference(&have).copied().collect();
+            for c in have.difference(&want) {
+                sum += free.iter().map(|t| (*t - *c).l1()).min().unwrap_or(0) as usize;
+            }
+        }
+        sum
+    }
+
+    /// Best-first search from the start and from the goal at once, in
+    /// turn, until they meet (every atom operation can be undone, so the
+    /// goal's side runs the same operations). States are kept as compact
+    /// keys ([`Scene::key`]); `None` when no sequence exists within the
+    /// room, reach and `max_ops`, or `max_states` are explored first. The
+    /// chain is renamed onto the start's atoms and packed as in
+    /// [`Problem::solve_guided`].
+    pub fn solve_bidirectional(&self, weight: usize, max_states: usize) -> Option<Found> {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        struct Side {
+            seen: FxHashMap<Box<[u8]>, u32>,
+            keys: Vec<Box<[u8]>>,
+            parent: Vec<u32>,
+            open: BinaryHeap<Reverse<(usize, usize, u32)>>,
+        }
+        impl Side {
+            fn chain(&self, mut i: u32) -> Vec<Box<[u8]>> {
+                let mut out = Vec::new();
+                while i != u32::MAX {
+                    out.push(self.keys[i as usize].clone());
+                    i = self.parent[i as usize];
+                }
+                out.reverse();
+                out
+            }
+        }
+        let n = self.start.pos.len();
+        let ends = [
+            self.canon(self.start.clone()),
+            self.canon(self.goal.clone()),
+        ];
+        let mut sides: Vec<Side> = (0..2)
+            .map(|k| {
+                let key = ends[k].key();
+                Side {
+                    seen: FxHashMap::from_iter([(key.clone(), 0)]),
+                    keys: vec![key],
+                    parent: vec![u32::MAX],
+                    open: BinaryHeap::from([Reverse((
+                        weight * self.distance(&ends[k], &ends[1 - k]),
+                        0,
+                        0,
+                    ))]),
+                }
+            })
+            .collect();
+        let chain = 'search: {
+            if sides[0].keys[0] == sides[1].keys[0] {
+                break 'search vec![sides[0].keys[0].clone()];
+            }
+            let mut turn = 0;
+            loop {
+                if sides[0].keys.len() + sides[1].keys.len() >= max_states {
+                    return None;
+                }
+                let k = turn % 2;
+                turn += 1;
+                let Some(Reverse((_, depth, id))) = sides[k].open.pop() else {
+                    if sides[1 - k].open.is_empty() {
+                        return None;
+                    }
+                    continue;
+                };
+                if depth >= self.max_ops {
+                    continue;
+                }
+                let s = Scene::from_key(&sides[k].keys[id as usize], n);
+                for op in self.candidate_ops(&s) {
+                    let Some(next) = s.step(&[op], &self.anchors, self.eps) else {
+                        continue;
+                    };
+                    if !self.within_reach(&next) {
+                        continue;
+                    }
+                    let next = self.canon(next);
+                    let key = next.key();
+                    if sides[k].seen.contains_key(&key) {
+                        continue;
+                    }
+                    let nid = sides[k].keys.len() as u32;
+                    sides[k].seen.insert(key.clone(), nid);
+                    sides[k].keys.push(key.clone());
+                    sides[k].parent.push(id);
+                    if let Some(&other) = sides[1 - k].seen.get(&key) {
+                        let (f, b) = if k == 0 { (nid, other) } else { (other, nid) };
+                        let mut chain = sides[0].chain(f);
+                        let mut back = sides[1].chain(b);
+                        back.reverse();
+                        chain.extend(back.into_iter().skip(1));
+                        break 'search chain;
+                    }
+                    let f = depth + 1 + weight * self.distance(&next, &ends[1 - k]);
+                    sides[k].open.push(Reverse((f, depth + 1, nid)));
+                }
+            }
+        };
+        let states_explored = sides[0].keys.len() + sides[1].keys.len();
+        // Rename the chain onto the start's atoms: at each link, the one
+        // operation from the real state whose canonical result is the next.
+        let mut real = self.start.clone();
+        let mut ops = Vec::with_capacity(chain.len());
+        for key in &chain[1..] {
+            let (op, next) = self
+                .candidate_ops(&real)
+                .into_iter()
+                .filter_map(|op| Some((op, real.step(&[op], &self.anchors, self.eps)?)))
+                .find(|(_, nx)| self.canon(nx.clone()).key() == *key)
+                .expect("each link of the chain is one operation");
+            ops.push(op);
+            real = next;
+        }
+        let steps = self.pack(&ops);
+        Some(Found {
+            ops,
+            steps,
+            states_explored,
+        })
+    }
+
     /// Operations found on canonical states, renamed to the start's atoms
     /// by replaying them (the step rules do not depend on atom order, and
-    /// the anchors stay first in every canonical order).
+    /// the anchors are in no exchange group).
     fn name_atoms(&self, canonical_ops: &[Op]) -> Vec<Op> {
         let mut real = self.start.clone();
         let mut out = Vec::with_capacity(canonical_ops.len());
         for &op in canonical_ops {
-            let (_, idx) = real.canonical();
+            let (_, idx) = real.canonical_in(&self.exchange);
             let named = op.renamed(|a| idx[a]);
             real = real
                 .step(&[named], &self.anchors, self.eps)
@@ -662,7 +864,7 @@ pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, 
         max_ops: 60,
         eps: 1e-6,
         room: None,
-        exchange: false,
+        exchange: Vec::new(),
     };
     (problem, label)
 }
@@ -799,13 +1001,13 @@ impl Legs {
 /// (seed 004 Fig. 12): the leaf A at meta cell (0, 1) is pushed into the
 /// turn B (0, 0), whose mass pops out at (1, 0). B hangs on the rest of
 /// the robot through L (−1, 0), opposite the way out (the frame). The
-/// goal lists A's atoms where B's were and B's one cell along +x, but the
-/// problem treats atoms as interchangeable (`exchange`): no sequence that
-/// keeps each meta-module's atoms was found (docs/atoms.md), so any atoms
-/// on the goal's cells meet it. Legs: D (0, 2) behind A ends at (0, 1),
-/// E (1, 0) ahead ends at (2, 0); they do not act, and, atoms being
-/// interchangeable, nothing keeps a leg's atoms on their leg (a looser
-/// search than a rigid leg). Room: the cells of the path, L, and the
+/// goal lists A's atoms where B's were and B's one cell along +x, but A's
+/// and B's atoms are one group of interchangeable atoms (`exchange`), so
+/// any of them on those cells meet it. Legs: D (0, 2) behind A ends at
+/// (0, 1), E (1, 0) ahead ends at (2, 0); they do not act, and each is a
+/// group of its own, so a leg keeps its atoms and, acting on none of its
+/// faces, moves rigidly: a longer leg's further meta-modules, attached to
+/// it and to nothing else, ride with it. Room: the cells of the path, L, and the
 /// corner (1, 1) between the two legs, which a comb's bounding boxes
 /// usually hold where it tunnels (docs/atoms.md); where a robot's boxes
 /// do not, the certifier refuses the move as out of place. Only A's and
@@ -869,7 +1071,11 @@ pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, V
         max_ops: 60,
         eps: 1e-6,
         room: Some(room),
-        exchange: true,
+        exchange: ["AB", "D", "E"]
+            .iter()
+            .map(|g| (0..n).filter(|&a| is(a, g)).collect::<Vec<usize>>())
+            .filter(|g| !g.is_empty())
+            .collect(),
     };
     (problem, label)
 }

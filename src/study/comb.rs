@@ -93,8 +93,7 @@ pub struct TheoremRow {
     pub phase_steps: [usize; 4],
     /// Tunnels with one and with two turns (phases 2 and 3).
     pub tunnels: [usize; 2],
-    /// Tunnels whose every leg is one meta-module long: the only ones with
-    /// a derived atom sequence.
+    /// Tunnels whose every leg is one meta-module long.
     pub short_tunnels: usize,
     /// The longest leg of any tunnel (meta-modules between its end and its
     /// turn, or between two turns).

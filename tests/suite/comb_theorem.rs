@@ -220,7 +220,7 @@ fn a_theorem_1_scenario_is_refused_at_atom_level_naming_the_tunnel_and_certified
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("t1.json") && err.contains("TUNNEL") && err.contains("legs"),
+        err.contains("t1.json") && err.contains("1-TUNNEL") && err.contains("turns 2 times"),
         "{err}"
     );
     let o = common::bin()

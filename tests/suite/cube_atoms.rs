@@ -472,8 +472,14 @@ fn tunnel_robot(map: impl Fn([i32; 3]) -> [i32; 3]) -> (Vec<(u32, [i32; 3], bool
 
 #[test]
 fn a_derived_one_tunnel_certifies_atom_by_atom_turned_and_mirrored() {
-    let lib = reconfcheck::geometry::atom_expand::tunnel_library(AtomRest::Contracted)
-        .expect("the contracted 1-TUNNEL is found");
+    let lib = reconfcheck::geometry::atom_expand::tunnel_library(
+        AtomRest::Contracted,
+        reconfcheck::geometry::atom_search::Legs {
+            behind: false,
+            ahead: false,
+        },
+    )
+    .expect("the contracted 1-TUNNEL is found");
     eprintln!(
         "1-TUNNEL, contracted: {} parallel steps, {} atom operations in 3D (2D slice: {} ops, {} states)",
         lib.steps.len(),
@@ -508,6 +514,47 @@ fn a_derived_one_tunnel_certifies_atom_by_atom_turned_and_mirrored() {
 }
 
 #[test]
+fn a_one_tunnel_with_long_legs_certifies_atom_by_atom_turned_and_mirrored() {
+    // The leaf D2 on top of an in-leg D2, D, A standing on the turn B; B
+    // on L, L on L2 (fixed); the out-leg E, E2 beside B. D2 tunnels down
+    // and out at (3, 0): every leg meta-module moves one cell along the
+    // path, rigidly (where each meta-module's atoms end is the unit test
+    // `after_a_tunnel_each_meta_module_is_the_atoms_in_its_cell`).
+    let maps: [fn([i32; 3]) -> [i32; 3]; 3] =
+        [|c| c, |[x, y, z]| [-x, y, z], |[x, y, z]| [z, -x, y]];
+    for (k, map) in maps.into_iter().enumerate() {
+        let metas = vec![
+            (0, map([-2, 0, 0]), true),
+            (1, map([-1, 0, 0]), false),
+            (2, map([0, 0, 0]), false),
+            (3, map([0, 1, 0]), false),
+            (4, map([0, 2, 0]), false),
+            (5, map([0, 3, 0]), false),
+            (6, map([1, 0, 0]), false),
+            (7, map([2, 0, 0]), false),
+        ];
+        let path: Vec<[i32; 3]> = [
+            [0, 3, 0],
+            [0, 2, 0],
+            [0, 1, 0],
+            [0, 0, 0],
+            [1, 0, 0],
+            [2, 0, 0],
+            [3, 0, 0],
+        ]
+        .into_iter()
+        .map(map)
+        .collect();
+        let steps = json!([{"events": [{"op": "tunnel", "module": 5, "path": path}]}]);
+        let s =
+            Schedule::from_json(&meta_doc(&metas, steps).to_string(), Path::new("t.json")).unwrap();
+        let r = run(&s);
+        assert!(r.certified, "placement {k}:\n{}", r.summary());
+        assert!(r.checks.iter().any(|c| c.contains("in place")));
+    }
+}
+
+#[test]
 fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
     let (metas, _) = tunnel_robot(|c| c);
     let turn = json!([[0, 1, 0], [0, 0, 0], [1, 0, 0]]);
@@ -517,13 +564,19 @@ fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
             "straight.json",
             None,
             json!([[0, 1, 0], [0, 0, 0], [0, -1, 0]]),
-            "turns once",
+            "this path turns 0 times",
+        ),
+        (
+            "twice.json",
+            None,
+            json!([[0, 1, 0], [0, 0, 0], [1, 0, 0], [1, 1, 0]]),
+            "this path turns 2 times",
         ),
         (
             "long.json",
             None,
             json!([[0, 1, 0], [0, 0, 0], [1, 0, 0], [2, 0, 0]]),
-            "path of 4 cells",
+            "runs through (1, 0, 0), where there is no meta-module",
         ),
         (
             "nohold.json",
@@ -532,10 +585,10 @@ fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
             "must hang on a meta-module at (1, 0, 0), opposite the exit",
         ),
         (
-            "leaf.json",
-            Some((5, [0, 2, 0], false)),
+            "below.json",
+            Some((5, [0, -1, 0], false)),
             turn.clone(),
-            "must be a leaf on the turn; meta-module 5 at (0, 2, 0)",
+            "may touch only the path and the meta-module opposite the exit; meta-module 5 at (0, -1, 0)",
         ),
         (
             "exit.json",

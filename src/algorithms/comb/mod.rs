@@ -395,9 +395,9 @@ pub enum Until {
     #[default]
     Comb,
     /// The target (Theorem 1): the comb, the common comb, and the target's
-    /// phases reversed. Its k-TUNNELs have legs longer than one
-    /// meta-module, which have no derived atom sequence: such a schedule
-    /// is certified at the meta-module level (`certify --meta-level`).
+    /// phases reversed. Its 2-TUNNELs have no derived atom sequence: such
+    /// a schedule is certified at the meta-module level
+    /// (`certify --meta-level`).
     Target,
 }
 
