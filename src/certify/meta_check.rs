@@ -61,32 +61,22 @@ impl Scene {
     }
 
     /// Meta-modules not joined by `bonds` to a fixed one (to the first if
-    /// none is fixed).
+    /// none is fixed), by union–find over the bonds (petgraph's).
     fn loose(&self, bonds: &FxHashSet<(usize, usize)>) -> Vec<ModuleId> {
         let n = self.pos.len();
-        let mut adj = vec![Vec::new(); n];
+        let mut uf = petgraph::unionfind::UnionFind::<usize>::new(n);
         for &(a, b) in bonds {
-            adj[a].push(b);
-            adj[b].push(a);
+            uf.union(a, b);
         }
-        let mut seen = vec![false; n];
-        let mut stack: Vec<usize> = if self.fixed.is_empty() {
+        let roots: Vec<usize> = if self.fixed.is_empty() {
             (0..n.min(1)).collect()
         } else {
             self.fixed.clone()
         };
-        for &s in &stack {
-            seen[s] = true;
-        }
-        while let Some(a) = stack.pop() {
-            for &b in &adj[a] {
-                if !seen[b] {
-                    seen[b] = true;
-                    stack.push(b);
-                }
-            }
-        }
-        (0..n).filter(|&a| !seen[a]).map(|a| self.ids[a]).collect()
+        (0..n)
+            .filter(|&a| !roots.iter().any(|&r| uf.equiv(a, r)))
+            .map(|a| self.ids[a])
+            .collect()
     }
 }
 
