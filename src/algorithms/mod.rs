@@ -41,6 +41,7 @@ pub fn registry() -> Vec<&'static dyn Generator> {
         &docking::Docking,
         &docking::Docking3d,
         &comb::Comb2d,
+        &comb::Comb3d,
         &repost::RepostOperation,
         &repost::Repost,
     ]

@@ -250,6 +250,89 @@ pub fn theorem_series(rows: &[TheoremRow]) -> [(&'static str, Vec<(f64, f64)>); 
     ]
 }
 
+/// One size of §3.2 (Theorem 2) in 3D, at the meta-module level.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Theorem3Row {
+    pub metas: usize,
+    pub atoms: usize,
+    /// Steps of the four phases, as in [`TheoremRow::phase_steps`].
+    pub phase_steps: [usize; 4],
+    /// Tunnels with 1, 2, 3 and 4 turns.
+    pub tunnels: [usize; 4],
+    pub meta_certified: Option<bool>,
+    pub generate_s: f64,
+    pub certify_s: Option<f64>,
+}
+
+/// Theorem 2 at each size: a seeded random source and target polycube of
+/// `m` meta-modules, certified at the meta-module level up to
+/// `certify_up_to`.
+pub fn theorem3(
+    sizes: &[usize],
+    seed: u64,
+    rest: AtomRest,
+    certify_up_to: usize,
+) -> Result<Vec<Theorem3Row>, InputError> {
+    use crate::algorithms::comb::three_d::{random_polycube, reconfigure3};
+    use crate::schedule::{Event, ModuleSpec, Step};
+    let mut rows = Vec::new();
+    for &m in sizes {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (m as u64).wrapping_mul(0xC2B2_AE35));
+        let (a, b) = (random_polycube(m, &mut rng), random_polycube(m, &mut rng));
+        let t0 = Instant::now();
+        let plan = reconfigure3(&a, &b);
+        let mut s = crate::schedule::Schedule::new(
+            crate::lattice::LatticeKind::Cubic,
+            crate::schedule::Length::mm(120.0),
+        );
+        s.meta_modules = Some(rest);
+        s.modules = a
+            .iter()
+            .enumerate()
+            .map(|(k, &cell)| ModuleSpec {
+                id: k as u32,
+                cell,
+                fixed: false,
+            })
+            .collect();
+        s.steps = plan
+            .steps()
+            .into_iter()
+            .map(|events| Step { events })
+            .collect();
+        let generate_s = t0.elapsed().as_secs_f64();
+        let mut tunnels = [0; 4];
+        for e in plan.steps().iter().flatten() {
+            if let Event::Tunnel { path, .. } = e {
+                let k = (1..path.len() - 1)
+                    .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
+                    .count();
+                tunnels[k.clamp(1, 4) - 1] += 1;
+            }
+        }
+        let (mut meta_certified, mut certify_s) = (None, None);
+        if m <= certify_up_to {
+            let t1 = Instant::now();
+            let opts = Options {
+                meta_level: true,
+                ..Options::lattice_only()
+            };
+            meta_certified = Some(certify::certify(&s, &opts)?.certified);
+            certify_s = Some(t1.elapsed().as_secs_f64());
+        }
+        rows.push(Theorem3Row {
+            metas: m,
+            atoms: 8 * m,
+            phase_steps: std::array::from_fn(|i| plan.phases[i].len()),
+            tunnels,
+            meta_certified,
+            generate_s,
+            certify_s,
+        });
+    }
+    Ok(rows)
+}
+
 /// Least-squares fit of `ln y = a + b·ln x` (slope `b`, intercept `a`,
 /// R² in log space): the power law `y = eᵃ·xᵇ`. Points with a
 /// non-positive coordinate are left out.

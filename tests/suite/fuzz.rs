@@ -380,6 +380,7 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),
         ("comb-2d", "metas = 6\nseed = 1\nuntil = \"target\""),
+        ("comb-3d", "metas = 6\nseed = 1\nuntil = \"target\""),
         (
             "active-subtraction",
             "mode = \"sas\"\n[random]\nwidth = 4\nheight = 4\ndensity = 0.5\nseed = 2\ngrowth = \"chain\"",

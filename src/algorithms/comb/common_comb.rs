@@ -140,9 +140,10 @@ impl Robot {
         let mut queue: VecDeque<(i32, i32)> = teeth.into();
         let handle = self.at.iter().filter(|c| c.1 == y0).count();
         for i in handle..u.teeth.len() {
-            let o = queue
-                .pop_front()
-                .expect("a comb has a tooth per missing handle cell");
+            // Too few teeth to make the handle (3D Step 1 leaves it partial).
+            let Some(o) = queue.pop_front() else {
+                return;
+            };
             self.tunnel(comb_path(o, (x0 + i as i32, y0), y0));
         }
         for i in (0..u.teeth.len()).rev() {

@@ -2,7 +2,7 @@
 //! meta-modules is combed (Algorithm 1, the wall sweep), and with
 //! `until = "target"` made the common comb (Algorithm 2) and then the
 //! target by the target's own two phases in reverse (Theorem 1,
-//! [`common_comb`]).
+//! [`common_comb`]); in 3D (§3.2, Theorem 2) by [`three_d`].
 //!
 //! The generator works on meta-modules (cells of the coarse cubic lattice,
 //! `z = 0`) and writes a `meta_modules` schedule: `slide` (the paper's
@@ -14,6 +14,7 @@
 //! it at the meta-module level otherwise (`certify --meta-level`).
 
 pub mod common_comb;
+pub mod three_d;
 
 use super::{Generator, parameters};
 use crate::error::InputError;
@@ -483,6 +484,80 @@ impl Generator for Comb2d {
             }
         };
         s.meta.insert("algorithm".into(), "comb-2d".into());
+        s.meta.insert("meta_modules".into(), src.len().into());
+        s.meta.insert("seed".into(), p.seed.into());
+        Ok(s)
+    }
+}
+
+/// Parameters of the `comb-3d` generator.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Comb3Params {
+    /// Random connected polycubes of `metas` meta-modules from `seed`
+    /// (source, then target).
+    #[serde(default = "default_metas")]
+    pub metas: usize,
+    #[serde(default)]
+    pub seed: u64,
+    #[serde(default = "default_rest")]
+    pub model: AtomRest,
+    /// How far to go (see [`Until`]); `"target"` is Theorem 2.
+    #[serde(default)]
+    pub until: Until,
+}
+
+/// The `comb-3d` generator (§3.2, at the meta-module level: its SLIDEs
+/// along perpendicular walls and its k-TUNNELs have no derived atom
+/// sequence; certify with `--meta-level`).
+pub struct Comb3d;
+
+impl Generator for Comb3d {
+    fn name(&self) -> &'static str {
+        "comb-3d"
+    }
+
+    fn about(&self) -> &'static str {
+        "seed 004 in 3D: combing to a terrain and a 3D comb, and with until = \"target\" the 3D common comb and the target (meta-module level)"
+    }
+
+    fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
+        let p: Comb3Params = parameters(scenario)?;
+        if p.metas == 0 {
+            return Err(scenario.error("metas must be at least 1"));
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+        let src = three_d::random_polycube(p.metas, &mut rng);
+        let tgt = three_d::random_polycube(p.metas, &mut rng);
+        let (steps, phases) = match p.until {
+            Until::Comb => {
+                let mut r = three_d::Robot3::new(&src);
+                r.comb();
+                (r.steps, vec![])
+            }
+            Until::Target => {
+                let plan = three_d::reconfigure3(&src, &tgt);
+                let phases: Vec<serde_json::Value> =
+                    plan.phases.iter().map(|ph| ph.len().into()).collect();
+                (plan.steps(), phases)
+            }
+        };
+        let mut s = Schedule::new(LatticeKind::Cubic, Length::mm(120.0));
+        s.meta_modules = Some(p.model);
+        s.modules = src
+            .iter()
+            .enumerate()
+            .map(|(k, &c)| ModuleSpec {
+                id: k as ModuleId,
+                cell: c,
+                fixed: false,
+            })
+            .collect();
+        s.steps = steps.into_iter().map(|events| Step { events }).collect();
+        if !phases.is_empty() {
+            s.meta.insert("phase_steps".into(), phases.into());
+        }
+        s.meta.insert("algorithm".into(), "comb-3d".into());
         s.meta.insert("meta_modules".into(), src.len().into());
         s.meta.insert("seed".into(), p.seed.into());
         Ok(s)
