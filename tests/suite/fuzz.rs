@@ -379,8 +379,8 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
             "active-subtraction",
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),
-        ("comb-2d", "metas = 6\nseed = 1\nuntil = \"target\""),
-        ("comb-3d", "metas = 6\nseed = 1\nuntil = \"target\""),
+        ("comb-2d", "metas = 6\nseed = 1\nuntil = \"comb\""),
+        ("comb-3d", "metas = 6\nseed = 1\nuntil = \"comb\""),
         (
             "active-subtraction",
             "mode = \"sas\"\n[random]\nwidth = 4\nheight = 4\ndensity = 0.5\nseed = 2\ngrowth = \"chain\"",

@@ -409,6 +409,18 @@ fn default_rest() -> AtomRest {
     AtomRest::Contracted
 }
 
+/// Most meta-modules of a random robot: the studies go to 4,096;
+/// a larger count is refused rather than left to run for hours.
+pub const MAX_METAS: usize = 65_536;
+
+fn check_metas(scenario: &Scenario, metas: usize) -> Result<(), InputError> {
+    if (1..=MAX_METAS).contains(&metas) {
+        Ok(())
+    } else {
+        Err(scenario.error(format!("metas must be 1 … {MAX_METAS}, not {metas}")))
+    }
+}
+
 /// The source and target a scenario names, as meta-module shapes.
 pub fn shapes(scenario: &Scenario, p: &CombParams) -> Result<(Shape, Shape), InputError> {
     let read = |rel: &str| -> Result<Shape, InputError> {
@@ -431,9 +443,7 @@ pub fn shapes(scenario: &Scenario, p: &CombParams) -> Result<(Shape, Shape), Inp
             Ok((src, tgt))
         }
         (None, None) => {
-            if p.metas == 0 {
-                return Err(scenario.error("metas must be at least 1"));
-            }
+            check_metas(scenario, p.metas)?;
             let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
             let s = random_polyomino(p.metas, &mut rng);
             let t = random_polyomino(p.metas, &mut rng);
@@ -523,9 +533,7 @@ impl Generator for Comb3d {
 
     fn generate(&self, scenario: &Scenario) -> Result<Schedule, InputError> {
         let p: Comb3Params = parameters(scenario)?;
-        if p.metas == 0 {
-            return Err(scenario.error("metas must be at least 1"));
-        }
+        check_metas(scenario, p.metas)?;
         let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
         let src = three_d::random_polycube(p.metas, &mut rng);
         let tgt = three_d::random_polycube(p.metas, &mut rng);
