@@ -274,32 +274,14 @@ pub fn theorem3(
     certify_up_to: usize,
 ) -> Result<Vec<Theorem3Row>, InputError> {
     use crate::algorithms::comb::three_d::{random_polycube, reconfigure3};
-    use crate::schedule::{Event, ModuleSpec, Step};
+    use crate::schedule::Event;
     let mut rows = Vec::new();
     for &m in sizes {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (m as u64).wrapping_mul(0xC2B2_AE35));
         let (a, b) = (random_polycube(m, &mut rng), random_polycube(m, &mut rng));
         let t0 = Instant::now();
         let plan = reconfigure3(&a, &b);
-        let mut s = crate::schedule::Schedule::new(
-            crate::lattice::LatticeKind::Cubic,
-            crate::schedule::Length::mm(120.0),
-        );
-        s.meta_modules = Some(rest);
-        s.modules = a
-            .iter()
-            .enumerate()
-            .map(|(k, &cell)| ModuleSpec {
-                id: k as u32,
-                cell,
-                fixed: false,
-            })
-            .collect();
-        s.steps = plan
-            .steps()
-            .into_iter()
-            .map(|events| Step { events })
-            .collect();
+        let s = crate::algorithms::comb::three_d::schedule_of(&a, plan.steps(), rest);
         let generate_s = t0.elapsed().as_secs_f64();
         let mut tunnels = [0; 4];
         for e in plan.steps().iter().flatten() {

@@ -295,32 +295,14 @@ fn a_combing_run_in_reverse_certifies_atom_by_atom() {
 
 #[test]
 fn theorem_2_schedules_in_3d_certify_at_the_meta_level_and_end_at_the_target() {
-    use reconfcheck::algorithms::comb::three_d::{random_polycube, reconfigure3};
-    use reconfcheck::schedule::{Event, ModuleSpec, Step};
+    use reconfcheck::algorithms::comb::three_d::{random_polycube, reconfigure3, schedule_of};
+    use reconfcheck::schedule::Event;
     let mut turns_seen = std::collections::BTreeSet::new();
     for (m, seed) in [(4, 0), (9, 1), (16, 2), (27, 3), (48, 4), (80, 5)] {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let (a, b) = (random_polycube(m, &mut rng), random_polycube(m, &mut rng));
         let plan = reconfigure3(&a, &b);
-        let mut s = Schedule::new(
-            reconfcheck::lattice::LatticeKind::Cubic,
-            reconfcheck::schedule::Length::mm(120.0),
-        );
-        s.meta_modules = Some(AtomRest::Contracted);
-        s.modules = a
-            .iter()
-            .enumerate()
-            .map(|(k, &cell)| ModuleSpec {
-                id: k as u32,
-                cell,
-                fixed: false,
-            })
-            .collect();
-        s.steps = plan
-            .steps()
-            .into_iter()
-            .map(|events| Step { events })
-            .collect();
+        let s = schedule_of(&a, plan.steps(), AtomRest::Contracted);
         let r = meta_level(&s);
         assert!(r.certified, "m {m} seed {seed}:\n{}", r.summary());
         assert_eq!(r.per_step.len(), s.steps.len());

@@ -312,19 +312,19 @@ pub fn reversed<R: MetaRobot>(start: &R, steps: &[Vec<Event>]) -> Vec<Vec<Event>
 /// paper's common origin of the two combs): the meta-module steps of each
 /// of the four phases, and the robot at the end.
 #[derive(Clone, Debug)]
-pub struct Reconfiguration {
+pub struct Reconfiguration<S = Shape, R = Robot> {
     /// The target as reached (moved onto the source's origin).
-    pub target: Shape,
+    pub target: S,
     /// Steps of: combing the source; its comb to the common comb; the
     /// target's comb-to-common-comb reversed (with the attachment steps
     /// that make the two robots' latches agree first); the target's
     /// combing reversed.
     pub phases: [Vec<Vec<Event>>; 4],
     /// The robot after every phase, by the source's meta-module ids.
-    pub end: Robot,
+    pub end: R,
 }
 
-impl Reconfiguration {
+impl<S, R> Reconfiguration<S, R> {
     pub fn steps(&self) -> Vec<Vec<Event>> {
         self.phases.iter().flatten().cloned().collect()
     }

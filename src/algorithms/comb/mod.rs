@@ -550,18 +550,7 @@ impl Generator for Comb3d {
                 (plan.steps(), phases)
             }
         };
-        let mut s = Schedule::new(LatticeKind::Cubic, Length::mm(120.0));
-        s.meta_modules = Some(p.model);
-        s.modules = src
-            .iter()
-            .enumerate()
-            .map(|(k, &c)| ModuleSpec {
-                id: k as ModuleId,
-                cell: c,
-                fixed: false,
-            })
-            .collect();
-        s.steps = steps.into_iter().map(|events| Step { events }).collect();
+        let mut s = three_d::schedule_of(&src, steps, p.model);
         if !phases.is_empty() {
             s.meta.insert("phase_steps".into(), phases.into());
         }

@@ -452,20 +452,36 @@ impl Robot3 {
     }
 }
 
-/// Theorem 2's reconfiguration in 3D: the four phases as in 2D
-/// ([`super::common_comb::Reconfiguration`]), the combing being the two
-/// sweeps of [`Robot3::comb`].
-#[derive(Clone, Debug)]
-pub struct Reconfiguration3 {
-    pub target: Shape3,
-    pub phases: [Vec<Vec<Event>>; 4],
-    pub end: Robot3,
-}
+/// Theorem 2's reconfiguration in 3D: the four phases as in 2D, the
+/// combing being the two sweeps of [`Robot3::comb`].
+pub type Reconfiguration3 = super::common_comb::Reconfiguration<Shape3, Robot3>;
 
-impl Reconfiguration3 {
-    pub fn steps(&self) -> Vec<Vec<Event>> {
-        self.phases.iter().flatten().cloned().collect()
-    }
+/// A `meta_modules` schedule of `steps` from the robot `start` (ids in
+/// its order), no meta-module fixed (the robot must stay one piece).
+pub fn schedule_of(
+    start: &Shape3,
+    steps: Vec<Vec<Event>>,
+    rest: crate::lattice::AtomRest,
+) -> crate::schedule::Schedule {
+    let mut s = crate::schedule::Schedule::new(
+        crate::lattice::LatticeKind::Cubic,
+        crate::schedule::Length::mm(120.0),
+    );
+    s.meta_modules = Some(rest);
+    s.modules = start
+        .iter()
+        .enumerate()
+        .map(|(k, &cell)| crate::schedule::ModuleSpec {
+            id: k as ModuleId,
+            cell,
+            fixed: false,
+        })
+        .collect();
+    s.steps = steps
+        .into_iter()
+        .map(|events| crate::schedule::Step { events })
+        .collect();
+    s
 }
 
 /// §3.2: `source` to `target` (moved onto the source's lowest corner).
@@ -497,7 +513,7 @@ pub fn reconfigure3(source: &Shape3, target: &Shape3) -> Reconfiguration3 {
     debug_assert_eq!(shape(&s), shape(&t), "one common comb");
     let ccs_t = std::mem::take(&mut t.steps);
     let (phase3, back_comb) = join_reversed(&mut s, &t, &t0, &comb_t, &after_comb_t, &ccs_t);
-    Reconfiguration3 {
+    super::common_comb::Reconfiguration {
         target,
         phases: [comb_s, common_s, phase3, back_comb],
         end: s,
