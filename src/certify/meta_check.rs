@@ -117,11 +117,6 @@ fn final_cells(s: &Schedule) -> Vec<Cell> {
     at.into_values().collect()
 }
 
-/// Turns of an orthogonal path, and whether its cell `i` is a turn.
-fn is_turn(path: &[Cell], i: usize) -> bool {
-    path[i] - path[i - 1] != path[i + 1] - path[i]
-}
-
 /// Certifies a `meta_modules` schedule at the meta-module level (see the
 /// module doc). Unusable input (unknown meta-modules, a move from a cell
 /// it is not in, a path that is not a chain of neighbours, a fixed
@@ -368,6 +363,7 @@ fn meta_step(
                 if sc.at.contains_key(&exit) {
                     out.push(tunnel(format!("its exit {exit} is occupied")));
                 }
+                let turns = crate::lattice::path_turns(path);
                 let mut ok = true;
                 for (i, c) in path.iter().enumerate().take(path.len() - 1).skip(1) {
                     match sc.at.get(c) {
@@ -379,7 +375,7 @@ fn meta_step(
                                     held.contains(&pair(m, o)) && !path.contains(&sc.pos[o])
                                 })
                                 .collect();
-                            if !is_turn(path, i) && !off.is_empty() {
+                            if !turns.contains(&i) && !off.is_empty() {
                                 out.push(tunnel(format!(
                                     "meta-module {} is attached to the leg at {c} between turns",
                                     sc.ids[off[0]]
@@ -394,9 +390,11 @@ fn meta_step(
                         }
                     }
                 }
-                let turns = (1..path.len() - 1).filter(|&i| is_turn(path, i)).count();
-                if turns > MAX_TURNS {
-                    out.push(tunnel(format!("{turns} turns, more than {MAX_TURNS}")));
+                if turns.len() > MAX_TURNS {
+                    out.push(tunnel(format!(
+                        "{} turns, more than {MAX_TURNS}",
+                        turns.len()
+                    )));
                 }
                 let partners: Vec<usize> = sc
                     .partners(a)

@@ -284,9 +284,7 @@ fn one_tunnel(
             w[0], w[1]
         ));
     }
-    let turns: Vec<usize> = (1..path.len() - 1)
-        .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
-        .collect();
+    let turns = crate::lattice::path_turns(path);
     let [t] = turns[..] else {
         return Err(format!(
             "only the 1-TUNNEL (one turn) is derived; this path turns {} times",

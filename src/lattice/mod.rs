@@ -16,7 +16,7 @@ pub use cell::Cell;
 pub use config::{Configuration, Ground, ModuleId};
 pub use cubic::{AtomRest, CubicLattice, Face};
 pub use fcc::{FccLattice, directions as fcc_directions};
-pub use moves::{Motion, MoveError, MoveRequirements, Route};
+pub use moves::{Motion, MoveError, MoveRequirements, Route, path_turns};
 pub use square::SquareLattice;
 
 use glam::DVec3;

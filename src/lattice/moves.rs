@@ -121,3 +121,11 @@ pub(crate) fn wall_slide(
         ..Default::default()
     })
 }
+
+/// The interior cells, by index, where an orthogonal path changes
+/// direction: the turns of seed 004's k-TUNNEL (k of them).
+pub fn path_turns(path: &[Cell]) -> Vec<usize> {
+    (1..path.len().saturating_sub(1))
+        .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
+        .collect()
+}

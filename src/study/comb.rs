@@ -115,18 +115,11 @@ pub struct TheoremRow {
 /// turns, each as the number of cell-to-cell steps it makes (a 1-TUNNEL
 /// of Fig. 12, leaf on the turn and exit beside it: legs 1 and 1).
 fn legs(path: &[crate::lattice::Cell]) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut run = 1;
-    for w in path.windows(3) {
-        if w[1] - w[0] == w[2] - w[1] {
-            run += 1;
-        } else {
-            out.push(run);
-            run = 1;
-        }
-    }
-    out.push(run);
-    out
+    let ends: Vec<usize> = std::iter::once(0)
+        .chain(crate::lattice::path_turns(path))
+        .chain(std::iter::once(path.len() - 1))
+        .collect();
+    ends.windows(2).map(|w| w[1] - w[0]).collect()
 }
 
 /// Theorem 1 at each size: a seeded random source and target of `m`
@@ -137,7 +130,7 @@ pub fn theorem(
     rest: AtomRest,
     certify_up_to: usize,
 ) -> Result<Vec<TheoremRow>, InputError> {
-    use crate::algorithms::comb::common_comb::{reconfigure, turns};
+    use crate::algorithms::comb::common_comb::reconfigure;
     use crate::algorithms::comb::{meta_schedule_at, meta_schedule_framed};
     use crate::schedule::Event;
     let mut rows = Vec::new();
@@ -188,8 +181,7 @@ pub fn theorem(
         let (mut short, mut longest) = (0, 0);
         for e in plan.phases[1..3].iter().flatten().flatten() {
             if let Event::Tunnel { path, .. } = e {
-                let p: Vec<(i32, i32)> = path.iter().map(|c| (c.x, c.y)).collect();
-                tunnels[turns(&p).clamp(1, 2) - 1] += 1;
+                tunnels[crate::lattice::path_turns(path).len().clamp(1, 2) - 1] += 1;
                 let l = legs(path);
                 short += usize::from(l.iter().all(|&n| n == 1));
                 longest = longest.max(l.into_iter().max().unwrap_or(0));
@@ -286,9 +278,7 @@ pub fn theorem3(
         let mut tunnels = [0; 4];
         for e in plan.steps().iter().flatten() {
             if let Event::Tunnel { path, .. } = e {
-                let k = (1..path.len() - 1)
-                    .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
-                    .count();
+                let k = crate::lattice::path_turns(path).len();
                 tunnels[k.clamp(1, 4) - 1] += 1;
             }
         }

@@ -315,11 +315,7 @@ fn theorem_2_schedules_in_3d_certify_at_the_meta_level_and_end_at_the_target() {
                 }
                 Event::Tunnel { module, path } => {
                     at.insert(*module, *path.last().unwrap());
-                    turns_seen.insert(
-                        (1..path.len() - 1)
-                            .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
-                            .count(),
-                    );
+                    turns_seen.insert(reconfcheck::lattice::path_turns(path).len());
                 }
                 _ => {}
             }

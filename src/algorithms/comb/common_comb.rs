@@ -95,29 +95,18 @@ pub fn comb_path(from: (i32, i32), to: (i32, i32), y0: i32) -> Vec<(i32, i32)> {
     p
 }
 
-/// Turns of an orthogonal path: the interior cells where it changes
-/// direction (the paper's k of k-TUNNEL).
-pub fn turns(path: &[(i32, i32)]) -> usize {
-    path.windows(3)
-        .filter(|w| (w[1].0 - w[0].0, w[1].1 - w[0].1) != (w[2].0 - w[1].0, w[2].1 - w[1].1))
-        .count()
-}
-
 impl Robot {
-    /// One k-TUNNEL step: the leaf at `from` leaves, the exit `to` at the
-    /// end of `path` fills; the leaf lets go of its one neighbour and
-    /// attaches to the exit's neighbour on the path (as a SLIDE relatches).
+    /// One k-TUNNEL step along `path` (see [`apply`]).
     pub(super) fn tunnel(&mut self, path: Vec<(i32, i32)>) {
-        let (from, to) = (path[0], *path.last().expect("a path"));
-        let leaf = self.get(from).expect("a leaf at the tunnel's start");
-        let support = self.get(path[path.len() - 2]).expect("an occupied path");
-        self.attached.retain(|&(a, b)| a != leaf && b != leaf);
-        self.attached.insert(pair(leaf, support));
-        self.steps.push(vec![Event::Tunnel {
-            module: leaf as ModuleId,
-            path: path.iter().map(|&c| super::cell(c)).collect(),
-        }]);
-        self.relocate(&[(leaf, to)]);
+        let leaf = self.get(path[0]).expect("a leaf at the tunnel's start");
+        let path = path.into_iter().map(super::cell).collect();
+        apply(
+            self,
+            &[Event::Tunnel {
+                module: leaf as ModuleId,
+                path,
+            }],
+        );
     }
 
     /// Height of the tooth on handle column `x` (handle row `y0`).
@@ -516,7 +505,7 @@ mod tests {
                             );
                         }
                     }
-                    ks.push(turns(&p));
+                    ks.push(crate::lattice::path_turns(path).len());
                 }
             }
             r.apply(es);

@@ -594,9 +594,7 @@ mod tests {
             assert_eq!(shape(&r), u.common_comb(m), "seed {seed}");
             for e in plan.phases[1].iter().flatten() {
                 if let Event::Tunnel { path, .. } = e {
-                    let turns = (1..path.len() - 1)
-                        .filter(|&i| path[i] - path[i - 1] != path[i + 1] - path[i])
-                        .count();
+                    let turns = crate::lattice::path_turns(path).len();
                     assert!(turns <= 4, "seed {seed}: {turns} turns");
                 }
             }
