@@ -151,6 +151,24 @@ fn the_meta_level_certificate_catches_each_broken_rule_mirrored_too() {
             Some(ViolationKind::MoverDetached),
         ),
         (
+            "a slider still attached to a meta-module it leaves",
+            vec![
+                (0, [0, 0]),
+                (1, [0, 1]),
+                (2, [1, 1]),
+                (3, [2, 1]),
+                (4, [2, 0]),
+            ],
+            json!([{"events": [{"op": "slide", "module": 2, "from": [1, 1, 0], "to": [1, 0, 0], "pivot": 1}]}]),
+            Some(ViolationKind::LatchNotAdjacent),
+        ),
+        (
+            "a carried meta-module with no slider",
+            vec![(0, [0, 0]), (1, [1, 0])],
+            json!([{"events": [{"op": "slide", "module": 1, "from": [1, 0, 0], "to": [1, 1, 0]}]}]),
+            Some(ViolationKind::MoverDetached),
+        ),
+        (
             "a detach that splits the robot",
             comb(),
             json!([{"events": [{"op": "detach", "module": 1, "other": 2}]}]),
