@@ -395,17 +395,23 @@ impl Problem {
                 return false;
             }
         }
-        if !self.exchange.is_empty() {
-            // Atom indices name places in a canonical order, not atoms.
-            return true;
-        }
+        // Within an exchange group atom indices name places in a canonical
+        // order, not atoms: the pins hold for the others only (a carried
+        // meta-module outside the groups stays pinned; they were skipped
+        // whenever groups were set, found by a helper's probe).
+        let grouped = |a: usize| self.exchange.iter().any(|g| g.contains(&a));
         let axis = |c: Cell, i: usize| [c.x, c.y, c.z][i];
         if self
             .pinned
             .iter()
-            .any(|&(a, i)| axis(s.pos[a], i) != axis(self.start.pos[a], i))
+            .any(|&(a, i)| !grouped(a) && axis(s.pos[a], i) != axis(self.start.pos[a], i))
         {
             return false;
+        }
+        if !self.exchange.is_empty() {
+            // The reach bounds atoms by their own start and goal: with
+            // groups, the search keeps to its room instead.
+            return true;
         }
         s.pos.iter().enumerate().all(|(a, p)| {
             let d0 = (*p - self.start.pos[a]).linf();
@@ -1037,10 +1043,17 @@ pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, V
         label.extend([l; 4]);
         room_meta.extend([from, to]);
     }
+    // A meta cell's atoms and their arms: in the expanded model an atom at
+    // 2·m·sp reaches one unit below it, and the slice's arms reach ±z (the
+    // room was off by one there, so no expanded state fitted in it; found
+    // by a helper's probe). The contracted model's room is unchanged.
+    let o = (sp - 1) / 2;
     for (mx, my) in room_meta {
-        for x in 2 * mx * sp..(2 * mx + 2) * sp {
-            for y in 2 * my * sp..(2 * my + 2) * sp {
-                room.insert(Cell::new(x, y, 0));
+        for x in 2 * mx * sp - o..(2 * mx + 2) * sp - o {
+            for y in 2 * my * sp - o..(2 * my + 2) * sp - o {
+                for z in -o..=o {
+                    room.insert(Cell::new(x, y, z));
+                }
             }
         }
     }
@@ -1078,4 +1091,44 @@ pub fn tunnel_problem(rest: crate::lattice::AtomRest, legs: Legs) -> (Problem, V
             .collect(),
     };
     (problem, label)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::AtomRest;
+
+    #[test]
+    fn pins_hold_outside_the_exchange_groups() {
+        // The SLIDE carrying D behind, A's atoms one exchange group: D is
+        // outside the groups and pinned in y, so a state with D moved
+        // across the slide is out of reach (it was let through whenever
+        // groups were set).
+        let (mut p, label) = slide_problem(AtomRest::Contracted, Carry::Behind);
+        p.exchange = vec![(0..label.len()).filter(|&a| label[a] == 'A').collect()];
+        assert!(p.within_reach(&p.start));
+        let d = (0..label.len()).find(|&a| label[a] == 'D').unwrap();
+        let mut moved = p.start.clone();
+        moved.pos[d].y += 1;
+        assert!(!p.within_reach(&moved));
+        // An atom of the group may be anywhere in the room.
+        let a = (0..label.len()).find(|&a| label[a] == 'A').unwrap();
+        let mut shuffled = p.start.clone();
+        shuffled.pos[a].y += 1;
+        assert!(p.within_reach(&shuffled));
+    }
+
+    #[test]
+    fn a_tunnels_room_holds_its_start_in_both_models() {
+        // The expanded model's atoms reach one unit below their cell and
+        // ±z with their arms; the room was one unit off, so the search
+        // ended at its first state.
+        for rest in [AtomRest::Contracted, AtomRest::Expanded] {
+            for legs in Legs::ALL {
+                let (p, _) = tunnel_problem(rest, legs);
+                assert!(p.within_reach(&p.start), "{rest:?} {}", legs.name());
+                assert!(p.within_reach(&p.goal), "{rest:?} {}", legs.name());
+            }
+        }
+    }
 }
