@@ -50,6 +50,9 @@ pub struct AtomState {
     /// Attached pairs `(a, b)`, `a < b`, by index.
     pub bonds: BTreeSet<(usize, usize)>,
     pub anchors: Vec<usize>,
+    /// No atom is fixed: the robot lies free (on a table), and in each
+    /// step the frame is its heaviest part ([`AtomState::advance`]).
+    pub floating: bool,
     index: FxHashMap<ModuleId, usize>,
 }
 
@@ -109,7 +112,8 @@ impl AtomState {
             }
         }
         let mut anchors: Vec<usize> = (0..pos.len()).filter(|&k| s.modules[k].fixed).collect();
-        if anchors.is_empty() && !pos.is_empty() {
+        let floating = anchors.is_empty();
+        if floating && !pos.is_empty() {
             anchors.push(0);
         }
         Ok(AtomState {
@@ -118,6 +122,7 @@ impl AtomState {
             ext,
             bonds,
             anchors,
+            floating,
             index,
         })
     }
@@ -222,6 +227,7 @@ impl AtomState {
         let held = self.held(&plan);
         let bonds: Vec<Bond> = held.iter().map(|&p| self.bond_of(p)).collect();
         let end = match solve_step(&self.pos, &plan.ext1, &bonds, &self.anchors) {
+            Ok(end) if self.floating => self.hold_heaviest(end, &held, &plan),
             Ok(end) => end,
             Err(c) => {
                 out.violations.push(
@@ -278,6 +284,56 @@ impl AtomState {
         self.ext = plan.ext1;
         self.bonds = bonds;
         out
+    }
+
+    /// Which held bonds change length in the step (an arm between them
+    /// expands or contracts).
+    fn changing(&self, held: &[(usize, usize)], plan: &AtomPlan) -> Vec<bool> {
+        held.iter()
+            .map(|&(a, b)| {
+                let f = self.bond_of((a, b)).face;
+                plan.toggled.contains(&(a, f)) || plan.toggled.contains(&(b, f.opposite()))
+            })
+            .collect()
+    }
+
+    /// A robot with no fixed atom, in a step solved from an arbitrary
+    /// anchor: the step's motion seen from its heaviest rigid part (the
+    /// most atoms joined by bonds whose length does not change; ties: the
+    /// part of the lowest-numbered atom), which becomes the anchor. On a
+    /// table the heaviest part holds by its friction and the others slide,
+    /// as [`crate::mechanics::atom`] has it. From atom 0 instead, a step
+    /// that carries atom 0 along would move everything else, out of the
+    /// bounding boxes, and drag it all: seed 004's combing in 3D moves
+    /// every meta-module at some step.
+    fn hold_heaviest(
+        &mut self,
+        end: Vec<Cell>,
+        held: &[(usize, usize)],
+        plan: &AtomPlan,
+    ) -> Vec<Cell> {
+        let changing = self.changing(held, plan);
+        let n = self.pos.len();
+        let mut parts = petgraph::unionfind::UnionFind::<usize>::new(n);
+        for (&(a, b), &c) in held.iter().zip(&changing) {
+            if !c {
+                parts.union(a, b);
+            }
+        }
+        let labels = parts.into_labeling();
+        let mut size: FxHashMap<usize, (usize, usize)> = FxHashMap::default();
+        for (a, &l) in labels.iter().enumerate() {
+            size.entry(l).or_insert((0, a)).0 += 1;
+        }
+        let Some(&(_, frame)) = size
+            .values()
+            .max_by_key(|&&(count, first)| (count, std::cmp::Reverse(first)))
+        else {
+            return end;
+        };
+        self.anchors = vec![frame];
+        let shift = end[frame] - self.pos[frame];
+        end.into_iter().map(|e| e - shift).collect()
     }
 
     fn connectivity(&self, k: usize, held: &[(usize, usize)], out: &mut StepFindings) {
@@ -440,13 +496,7 @@ impl AtomState {
         m: &AtomMechanics,
         out: &mut StepFindings,
     ) {
-        let changing: Vec<bool> = held
-            .iter()
-            .map(|&(a, b)| {
-                let f = self.bond_of((a, b)).face;
-                plan.toggled.contains(&(a, f)) || plan.toggled.contains(&(b, f.opposite()))
-            })
-            .collect();
+        let changing = self.changing(held, plan);
         if !changing.iter().any(|&c| c) {
             out.max_utilisation = Some(0.0);
             return;

@@ -6,7 +6,13 @@
 //!   the slide direction): the SLIDE that [`crate::geometry::atom_search`]
 //!   derives, turned to the move's direction and wall by the lattice
 //!   symmetry that maps the canonical slide (−x along a wall at −y) onto it.
-//!   Every slide of one meta-level step runs in lockstep.
+//!   Every slide of one meta-level step runs in lockstep, shifted so that
+//!   the steps in which their carried meta-modules move coincide. A wall
+//!   across the slide's lift (3D: walls on two perpendicular sides) is
+//!   handed over atom by atom; attached atoms of two moving meta-modules
+//!   that the SLIDE moves at different times (a meta-module carried
+//!   beside the slice) let go for the move and latch again after it
+//!   (`in_lockstep`).
 //! * `slide` without a `pivot`: a meta-module carried by a SLIDE of the
 //!   same step (it has no operations of its own; its atoms move because
 //!   they are attached to the slider's).
@@ -32,7 +38,7 @@ use crate::error::InputError;
 use crate::lattice::config::ModuleId;
 use crate::lattice::{AtomRest, Cell, Face};
 use crate::schedule::{Event, ModuleSpec, Schedule, Step};
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::OnceLock;
 
 /// The SLIDE used for every slide: the 2D-slice search with both carried
@@ -44,6 +50,29 @@ pub struct SlideLibrary {
     /// The lifted steps; atom `q` of the lifted scene is atom `(q / 2) % 4`
     /// of the 2D slice's meta-module `q / 8`, at height `q % 2`.
     pub steps: Vec<Vec<Op>>,
+    /// Where each atom of the 2D slice is before the first step and after
+    /// each step (`track[t][a]`): how the slider's atoms move.
+    pub track: Vec<Vec<Cell>>,
+    /// The slice's carried atoms (the meta-modules behind and beside the
+    /// slider; none in the double slide's scene).
+    pub carried: Vec<usize>,
+}
+
+impl SlideLibrary {
+    /// The step in which the carried meta-modules move (all at once, one
+    /// whole cell): in the scene's, where it has them (the single wall's
+    /// SLIDE); else the last step in which the slider's atoms move (between
+    /// two walls: the trailing column, which a meta-module behind it
+    /// touches).
+    pub fn carrier_step(&self) -> Option<usize> {
+        let moves = |a: usize| {
+            (0..self.track.len() - 1).filter(move |&t| self.track[t + 1][a] != self.track[t][a])
+        };
+        match self.carried.first() {
+            Some(&a) => moves(a).next(),
+            None => (8..12).filter_map(|a| moves(a).next_back()).max(),
+        }
+    }
 }
 
 /// The SLIDE between two walls, searched once per process.
@@ -51,7 +80,7 @@ pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     library(rest, [&CONTRACTED, &EXPANDED], || {
-        super::atom_search::double_slide_problem(rest)
+        (super::atom_search::double_slide_problem(rest), Vec::new())
     })
 }
 
@@ -60,7 +89,11 @@ pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     library(rest, [&CONTRACTED, &EXPANDED], || {
-        slide_problem(rest, Carry::Both).0
+        let (problem, label) = slide_problem(rest, Carry::Both);
+        let carried = (0..label.len())
+            .filter(|&a| matches!(label[a], 'D' | 'E'))
+            .collect();
+        (problem, carried)
     })
 }
 
@@ -69,20 +102,28 @@ pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
 fn library(
     rest: AtomRest,
     cells: [&'static OnceLock<Option<SlideLibrary>>; 2],
-    problem: impl FnOnce() -> Problem,
+    problem: impl FnOnce() -> (Problem, Vec<usize>),
 ) -> Option<&'static SlideLibrary> {
     let cell = match rest {
         AtomRest::Contracted => cells[0],
         AtomRest::Expanded => cells[1],
     };
     cell.get_or_init(|| {
-        let problem = problem();
+        let (problem, carried) = problem();
         let found = problem.solve()?;
         let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+        let mut scene = problem.start.clone();
+        let mut track = vec![scene.pos.clone()];
+        for st in &found.steps {
+            scene = scene.step(st, &problem.anchors, problem.eps)?;
+            track.push(scene.pos.clone());
+        }
         Some(SlideLibrary {
             problem,
             found,
             steps,
+            track,
+            carried,
         })
     })
     .as_ref()
@@ -238,6 +279,150 @@ fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
             .map(|l| (l as usize, (l ^ bit) as usize))
             .collect(),
     )
+}
+
+fn pair_of(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+/// One move of a meta-level step as atom steps: a SLIDE or a tunnel.
+struct Plan {
+    steps: Vec<Vec<Event>>,
+    /// A SLIDE's walls across its lift, each with the meta-module beside
+    /// it in the slide direction (B and C, as for the wall in the plane).
+    lateral: Vec<(ModuleId, ModuleId)>,
+    /// The sliding meta-module (a SLIDE's).
+    mover: Option<ModuleId>,
+    /// The step in which the meta-modules it carries move (a SLIDE's).
+    carrier: Option<usize>,
+    /// The mover's atoms, each with its offset from its start after each
+    /// step (a SLIDE's; a tunnel's atoms are its library's business).
+    motion: Vec<(ModuleId, Vec<Cell>)>,
+}
+
+/// The moves of one meta-level step run together, as atom steps.
+///
+/// Every SLIDE's carried meta-modules move in one of its steps, all
+/// together, one cell (the derived SLIDE's second step; the first when it
+/// runs backwards): the moves are shifted so that those steps coincide.
+/// Then any attached pair of atoms of two different moving meta-modules
+/// (sliders or carried) that would travel differently, for instance a
+/// meta-module carried beside the slider's slice, across the lift, is
+/// attached to all four of the slider's atoms on that face, one of which
+/// the SLIDE moves a step earlier, is detached in the first step and
+/// attached again in the last, when both have arrived. Pairs that travel
+/// alike stay attached and carry. Bonds to meta-modules that do not move
+/// are left as the schedule has them: releasing those is the schedule's
+/// business, and the certifier's to check.
+fn in_lockstep(
+    plans: Vec<Plan>,
+    carried: &[(ModuleId, Cell)],
+    owner: &Owners,
+    at: &FxHashMap<ModuleId, Cell>,
+    by_cell: &FxHashMap<Cell, ModuleId>,
+    bonds: &FxHashSet<(ModuleId, ModuleId)>,
+) -> Vec<Vec<Event>> {
+    let carrier = plans.iter().filter_map(|p| p.carrier).max().unwrap_or(0);
+    let shift: Vec<usize> = plans
+        .iter()
+        .map(|p| p.carrier.map_or(0, |c| carrier - c))
+        .collect();
+    let len = plans
+        .iter()
+        .zip(&shift)
+        .map(|(p, s)| p.steps.len() + s)
+        .max()
+        .unwrap_or(0);
+    let mut steps: Vec<Vec<Event>> = vec![Vec::new(); len];
+    // Each moving atom's offset from its start after each step, and its
+    // meta-module.
+    let mut travel: FxHashMap<ModuleId, Vec<Cell>> = FxHashMap::default();
+    let mut movers: Vec<ModuleId> = Vec::new();
+    for (p, &s) in plans.iter().zip(&shift) {
+        for (t, st) in p.steps.iter().enumerate() {
+            steps[t + s].extend(st.iter().cloned());
+        }
+        for (a, offsets) in &p.motion {
+            let global = (0..=len)
+                .map(|t| offsets[t.saturating_sub(s).min(offsets.len() - 1)])
+                .collect();
+            travel.insert(*a, global);
+        }
+    }
+    movers.extend(plans.iter().filter_map(|p| p.mover));
+    for &(m, d) in carried {
+        for &a in &owner[&m] {
+            travel.insert(
+                a,
+                (0..=len)
+                    .map(|t| if t <= carrier { Cell::ZERO } else { d })
+                    .collect(),
+            );
+        }
+        movers.push(m);
+    }
+    if len == 0 {
+        return steps;
+    }
+    movers.sort_unstable();
+    movers.dedup();
+    let mut relatch = Vec::new();
+    for &m in &movers {
+        let c = at[&m];
+        for d in [Cell::new(1, 0, 0), Cell::new(0, 1, 0), Cell::new(0, 0, 1)] {
+            let Some(&o) = by_cell.get(&(c + d)) else {
+                continue;
+            };
+            if movers.binary_search(&o).is_err() {
+                continue;
+            }
+            for (la, lb) in face_pairs(c, c + d).expect("neighbours") {
+                let (a, b) = (owner[&m][la], owner[&o][lb]);
+                if bonds.contains(&pair_of(a, b)) && travel.get(&a) != travel.get(&b) {
+                    relatch.push((a, b));
+                }
+            }
+        }
+    }
+    for (a, b) in relatch {
+        steps[0].push(Event::Detach {
+            module: a,
+            other: b,
+        });
+        steps[len - 1].push(Event::Attach {
+            module: a,
+            other: b,
+        });
+    }
+    // A wall across the lift: each of the slider's atoms on that face lets
+    // go of the wall B in the step it starts to move and holds C from the
+    // end of the step in which it stops, so the slider holds on to that
+    // side throughout by the atoms standing still.
+    for p in &plans {
+        let Some(m) = p.mover else { continue };
+        for &(b, c) in &p.lateral {
+            for (la, lb) in face_pairs(at[&m], at[&b]).expect("a wall beside the slider") {
+                let a = owner[&m][la];
+                if !bonds.contains(&pair_of(a, owner[&b][lb])) {
+                    continue;
+                }
+                let Some(way) = travel.get(&a) else { continue };
+                let moving: Vec<usize> = (0..len).filter(|&t| way[t + 1] != way[t]).collect();
+                let (Some(&first), Some(&last)) = (moving.first(), moving.last()) else {
+                    continue;
+                };
+                steps[first].push(Event::Detach {
+                    module: a,
+                    other: owner[&b][lb],
+                });
+                steps[last].push(Event::Attach {
+                    module: a,
+                    other: owner[&c][lb],
+                });
+            }
+        }
+    }
+    steps
 }
 
 /// A 1-TUNNEL placed in the robot: the library of its legs, the scene's
@@ -402,10 +587,24 @@ fn expand_tracked(
             a
         }));
     }
+    // The attached atom pairs between meta-modules (at the start every
+    // touching pair, as the certifier has it), kept up to date from the
+    // latches emitted.
+    let mut bonds: FxHashSet<(ModuleId, ModuleId)> = FxHashSet::default();
+    for (&id, &c) in &at {
+        for d in [Cell::new(1, 0, 0), Cell::new(0, 1, 0), Cell::new(0, 0, 1)] {
+            if let Some(o) = by_cell.get(&(c + d)) {
+                for (la, lb) in face_pairs(c, c + d).expect("neighbours") {
+                    bonds.insert(pair_of(owner[&id][la], owner[o][lb]));
+                }
+            }
+        }
+    }
     for (k, step) in s.steps.iter().enumerate() {
         let k1 = k + 1;
         let mut latch: Vec<Event> = Vec::new();
-        let mut slides: Vec<Vec<Vec<Event>>> = Vec::new();
+        let mut slides: Vec<Plan> = Vec::new();
+        let mut tunnelled: Vec<ModuleId> = Vec::new();
         let mut moved: Vec<(ModuleId, Cell)> = Vec::new();
         let mut walls: FxHashMap<ModuleId, Vec<(Cell, Cell, ModuleId, ModuleId)>> =
             FxHashMap::default();
@@ -476,8 +675,9 @@ fn expand_tracked(
                     let lib = t.lib;
                     let turn = Turn::new(t.d, t.w);
                     let atom = |q: usize| lifted_atom(q, &t.ids, &turn, &owner);
-                    slides.push(
-                        lib.steps
+                    slides.push(Plan {
+                        steps: lib
+                            .steps
                             .iter()
                             .map(|st| {
                                 st.iter()
@@ -485,7 +685,12 @@ fn expand_tracked(
                                     .collect()
                             })
                             .collect(),
-                    );
+                        lateral: Vec::new(),
+                        mover: None,
+                        carrier: None,
+                        motion: Vec::new(),
+                    });
+                    tunnelled.push(id);
                     // Whose atoms each path cell holds at the end: the
                     // scene's where the search left them, the further leg
                     // meta-modules' one cell along the path; each cell
@@ -549,7 +754,31 @@ fn expand_tracked(
                     "a SLIDE carrying meta-modules both ahead of and behind the slider has no derived atom sequence".into(),
                 ));
             }
-            let (lib, ids, (d, w)) = match ws.as_slice() {
+            // The walls in the slide's plane run the derived SLIDE (one
+            // wall, or two opposite ones); a wall across the lift (the 3D
+            // combing's perpendicular walls) is handed over atom by atom.
+            if ws.iter().any(|x| x.0 != d0) {
+                return Err(err("a meta-module slides in two directions at once".into()));
+            }
+            let opposite = (0..ws.len()).find_map(|i| {
+                (i + 1..ws.len())
+                    .find(|&j| ws[j].1 == Cell::ZERO - ws[i].1)
+                    .map(|j| (i, j))
+            });
+            let in_plane: Vec<usize> = opposite.map_or(vec![0], |(i, j)| vec![i, j]);
+            let lateral: Vec<(ModuleId, ModuleId)> = (0..ws.len())
+                .filter(|i| !in_plane.contains(i))
+                .map(|i| (ws[i].2, ws[i].3))
+                .collect();
+            let w0 = ws[in_plane[0]].1;
+            if (0..ws.len())
+                .any(|i| !in_plane.contains(&i) && (ws[i].1 == w0 || ws[i].1 == Cell::ZERO - w0))
+                || lateral.len() > 2
+            {
+                return Err(err("a meta-module slides along the same wall twice".into()));
+            }
+            let primary: Vec<_> = in_plane.iter().map(|&i| ws[i]).collect();
+            let (lib, ids, (d, w)) = match primary.as_slice() {
                 [(d, w, b, c)] => {
                     let lib = slide_library(rest).ok_or_else(|| {
                         err("no atom sequence for SLIDE was found by the search".into())
@@ -572,11 +801,7 @@ fn expand_tracked(
                     };
                     (lib, ids, (*d, *w))
                 }
-                _ => {
-                    return Err(err(
-                        "a meta-module slides along one wall, or along two opposite walls in the same direction".into(),
-                    ));
-                }
+                _ => unreachable!("one wall or an opposite pair"),
             };
             let turn = Turn::new(if back { Cell::ZERO - d } else { d }, w);
             let atom = |q: usize| lifted_atom(q, &ids, &turn, &owner);
@@ -596,20 +821,63 @@ fn expand_tracked(
                     .map(|st| st.iter().map(event).collect())
                     .collect()
             };
-            slides.push(steps);
+            // The slider's atoms (the scene's third meta-module, slice
+            // atoms 8–11), where they are after each step of the run.
+            let last = lib.track.len() - 1;
+            let motion = (8..12)
+                .flat_map(|a2| (0..2).map(move |h| (a2, h)))
+                .map(|(a2, h)| {
+                    let offsets = (0..=last)
+                        .map(|t| {
+                            turn.apply(if back {
+                                lib.track[last - t][a2] - lib.track[last][a2]
+                            } else {
+                                lib.track[t][a2] - lib.track[0][a2]
+                            })
+                        })
+                        .collect();
+                    (atom(2 * a2 + h), offsets)
+                })
+                .collect();
+            slides.push(Plan {
+                steps,
+                lateral,
+                mover: Some(id),
+                carrier: lib
+                    .carrier_step()
+                    .map(|c| if back { last - 1 - c } else { c }),
+                motion,
+            });
         }
+        let first_new = out.steps.len();
         if !latch.is_empty() {
             out.steps.push(Step { events: latch });
         }
-        let len = slides.iter().map(Vec::len).max().unwrap_or(0);
-        for t in 0..len {
-            let events: Vec<Event> = slides
-                .iter()
-                .filter_map(|sl| sl.get(t))
-                .flatten()
-                .cloned()
-                .collect();
-            out.steps.push(Step { events });
+        let carried: Vec<(ModuleId, Cell)> = moved
+            .iter()
+            .filter(|(m, _)| !walls.contains_key(m) && !tunnelled.contains(m))
+            .map(|&(m, to)| {
+                let d = to - at[&m];
+                (m, Cell::new(d.x * 2 * sp, d.y * 2 * sp, d.z * 2 * sp))
+            })
+            .collect();
+        out.steps.extend(
+            in_lockstep(slides, &carried, &owner, &at, &by_cell, &bonds)
+                .into_iter()
+                .map(|events| Step { events }),
+        );
+        for st in &out.steps[first_new..] {
+            for e in &st.events {
+                match *e {
+                    Event::Attach { module, other } => {
+                        bonds.insert(pair_of(module, other));
+                    }
+                    Event::Detach { module, other } => {
+                        bonds.remove(&pair_of(module, other));
+                    }
+                    _ => {}
+                }
+            }
         }
         for (m, atoms) in retag {
             owner.insert(m, atoms);

@@ -5,7 +5,8 @@
 //! in the xy-plane), so gravity loads no face in bending; what the faces
 //! carry is the friction of the atoms an arm drags or pushes. Within a
 //! step, the bonds whose arm changes length split the robot into rigid
-//! parts; the part holding the anchor stays, every other part moves, and a
+//! parts; the part holding the anchor stays (the certifier's frame: the
+//! fixed atoms, or a free robot's heaviest rigid part), every other part moves, and a
 //! changing bond carries the friction `μ·m·g` of every atom in the parts
 //! beyond it (seen from the anchor), shared equally with the bonds in
 //! parallel with it between the same two parts. That force pulls the

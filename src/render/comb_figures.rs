@@ -7,32 +7,111 @@
 use crate::error::Error;
 use crate::lattice::AtomRest;
 use crate::render::{SvgCanvas, draw_err};
-use crate::study::comb::{Row, loglog_fit, series};
+use crate::study::comb::{
+    Row, Theorem3Row, TheoremRow, loglog_fit, series, theorem_series, theorem3_series,
+};
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Picture size in pixels.
 pub const SIZE: (u32, u32) = (900, 600);
 
-const COLOURS: [RGBColor; 4] = [
+const COLOURS: [RGBColor; 6] = [
     RGBColor(200, 0, 0),
     RGBColor(0, 0, 210),
     RGBColor(0, 140, 0),
     RGBColor(150, 0, 150),
+    RGBColor(210, 120, 0),
+    RGBColor(0, 150, 160),
 ];
+
+/// One measured series of a log–log plot.
+struct Series {
+    name: String,
+    points: Vec<(f64, f64)>,
+    /// Drawn with hollow markers (a baseline).
+    hollow: bool,
+}
 
 /// Draws the scaling plot of `rows` (one atom model) to `path`.
 pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
-    let data = series(rows);
+    let data: Vec<Series> = series(rows)
+        .into_iter()
+        .enumerate()
+        .map(|(k, (name, points))| Series {
+            name: name.to_string(),
+            points,
+            hollow: k >= 2,
+        })
+        .collect();
+    loglog(
+        &data,
+        &format!("Seed 004: 2D combing against n ({rest:?} model, log–log)"),
+        3,
+        path,
+    )
+}
+
+/// Draws Theorems 1 (2D) and 2 (3D) against atoms n: meta-module steps
+/// from source to target and the combing phases' atom operations (the
+/// phases certified atom by atom), beside `naive`, the naive
+/// one-meta-module-at-a-time baseline's atom operations (2D combing).
+pub fn theorems(
+    two: &[TheoremRow],
+    three: &[Theorem3Row],
+    naive: &[(f64, f64)],
+    path: &Path,
+) -> Result<(), Error> {
+    let t1 = theorem_series(two);
+    let t2 = theorem3_series(three);
+    let data = vec![
+        Series {
+            name: format!("Theorem 1, 2D: {}", t1[0].0),
+            points: t1[0].1.clone(),
+            hollow: false,
+        },
+        Series {
+            name: format!("Theorem 1, 2D: {}", t1[3].0),
+            points: t1[3].1.clone(),
+            hollow: false,
+        },
+        Series {
+            name: format!("Theorem 2, 3D: {}", t2[0].0),
+            points: t2[0].1.clone(),
+            hollow: false,
+        },
+        Series {
+            name: format!("Theorem 2, 3D: {}", t2[2].0),
+            points: t2[2].1.clone(),
+            hollow: false,
+        },
+        Series {
+            name: "naive baseline (2D combing, one at a time): atom operations".into(),
+            points: naive.to_vec(),
+            hollow: true,
+        },
+    ];
+    loglog(
+        &data,
+        "Seed 004: Theorems 1 and 2 against n (contracted model, log–log)",
+        4,
+        path,
+    )
+}
+
+/// Draws `data` on log–log axes, each series with its fitted power law,
+/// and guide lines of slope 1 and 2 through the first positive point of
+/// series `guide`.
+fn loglog(data: &[Series], caption: &str, guide: usize, path: &Path) -> Result<(), Error> {
     let positive = |v: f64| v.is_finite() && v > 0.0;
-    let xs: Vec<f64> = rows
+    let xs: Vec<f64> = data
         .iter()
-        .map(|r| r.atoms as f64)
+        .flat_map(|s| s.points.iter().map(|q| q.0))
         .filter(|&x| positive(x))
         .collect();
     let ys: Vec<f64> = data
         .iter()
-        .flat_map(|(_, p)| p.iter().map(|q| q.1))
+        .flat_map(|s| s.points.iter().map(|q| q.1))
         .filter(|&y| positive(y))
         .collect();
     let (x0, x1) = bounds(&xs);
@@ -41,10 +120,7 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
         let root = SvgCanvas::with_string(svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
         let mut c = ChartBuilder::on(&root)
-            .caption(
-                format!("Seed 004: 2D combing against n ({rest:?} model, log–log)"),
-                ("sans-serif", 18),
-            )
+            .caption(caption, ("sans-serif", 18))
             .margin(12)
             .margin_right(28)
             .x_label_area_size(44)
@@ -58,13 +134,14 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
             .y_label_formatter(&|y| format!("{y:.0}"))
             .draw()
             .map_err(draw_err)?;
-        // Guide lines through the smallest naive-operations point: slope 1
+        // Guide lines through the guide series' smallest point: slope 1
         // (O(n)) and 2 (O(n²)).
-        let anchor = data[3]
-            .1
-            .iter()
-            .copied()
-            .find(|p| positive(p.0) && positive(p.1));
+        let anchor = data.get(guide).and_then(|s| {
+            s.points
+                .iter()
+                .copied()
+                .find(|p| positive(p.0) && positive(p.1))
+        });
         if let Some((ax, ay)) = anchor {
             for (power, label) in [
                 (1.0, "guide: slope 1, O(n)"),
@@ -83,9 +160,10 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
                     .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], style));
             }
         }
-        for (k, (name, pts)) in data.iter().enumerate() {
-            let col = COLOURS[k];
-            let pts: Vec<(f64, f64)> = pts
+        for (k, s) in data.iter().enumerate() {
+            let col = COLOURS[k % COLOURS.len()];
+            let pts: Vec<(f64, f64)> = s
+                .points
                 .iter()
                 .copied()
                 .filter(|p| positive(p.0) && positive(p.1))
@@ -101,13 +179,12 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
                 .map_err(draw_err)?;
             }
             let label = match fit {
-                Some(f) => format!("{name}: slope {:.2}, R² {:.3}", f.slope, f.r2),
-                None => name.to_string(),
+                Some(f) => format!("{}: slope {:.2}, R² {:.3}", s.name, f.slope, f.r2),
+                None => s.name.clone(),
             };
-            // The naive baseline's two series are drawn hollow.
-            let baseline = k >= 2;
+            let hollow = s.hollow;
             c.draw_series(pts.iter().map(|&p| {
-                if baseline {
+                if hollow {
                     Circle::new(p, 4, col.stroke_width(2))
                 } else {
                     Circle::new(p, 4, col.filled())
@@ -118,7 +195,7 @@ pub fn scaling(rows: &[Row], rest: AtomRest, path: &Path) -> Result<(), Error> {
             .legend(move |(x, y)| {
                 EmptyElement::at((x + 9, y))
                     + PathElement::new([(-9, 0), (9, 0)], col.stroke_width(1))
-                    + if baseline {
+                    + if hollow {
                         Circle::new((0, 0), 4, col.stroke_width(2))
                     } else {
                         Circle::new((0, 0), 4, col.filled())

@@ -251,7 +251,19 @@ pub struct Theorem3Row {
     pub phase_steps: [usize; 4],
     /// Tunnels with 1, 2, 3 and 4 turns.
     pub tunnels: [usize; 4],
+    /// Parallel steps and atom operations of the two combing phases (the
+    /// source's to a terrain and a 3D comb, the target's in reverse),
+    /// expanded into atom operations (the k-TUNNELs of the other two are
+    /// not).
+    pub comb_steps: usize,
+    pub comb_operations: usize,
     pub meta_certified: Option<bool>,
+    /// The combing phases certified atom by atom (lattice, collision,
+    /// connectivity, in place).
+    pub atoms_certified: Option<bool>,
+    /// The combing phases' highest drive-load utilisation under
+    /// `models/cube-atom.toml` (assumed figures), when certified.
+    pub comb_utilisation: Option<f64>,
     pub generate_s: f64,
     pub certify_s: Option<f64>,
 }
@@ -264,8 +276,12 @@ pub fn theorem3(
     seed: u64,
     rest: AtomRest,
     certify_up_to: usize,
+    mechanics: Option<std::path::PathBuf>,
 ) -> Result<Vec<Theorem3Row>, InputError> {
-    use crate::algorithms::comb::three_d::{random_polycube, reconfigure3};
+    use crate::algorithms::comb::common_comb::apply;
+    use crate::algorithms::comb::three_d::{
+        Robot3, random_polycube, reconfigure3, schedule_at, schedule_of,
+    };
     use crate::schedule::Event;
     let mut rows = Vec::new();
     for &m in sizes {
@@ -273,7 +289,21 @@ pub fn theorem3(
         let (a, b) = (random_polycube(m, &mut rng), random_polycube(m, &mut rng));
         let t0 = Instant::now();
         let plan = reconfigure3(&a, &b);
-        let s = crate::algorithms::comb::three_d::schedule_of(&a, plan.steps(), rest);
+        let s = schedule_of(&a, plan.steps(), rest);
+        // The combing phases alone, from the robot where each starts, as
+        // in 2D (`theorem`), with no frame: the robot lies free.
+        let first = schedule_of(&a, plan.phases[0].clone(), rest);
+        let mut robot = Robot3::new(&a);
+        for es in plan.phases[..3].iter().flatten() {
+            apply(&mut robot, es);
+        }
+        let mut phase4 = plan.phases[3].clone();
+        let loose = detached_neighbours(&robot);
+        if !loose.is_empty() {
+            phase4.insert(0, loose);
+        }
+        let last = schedule_at(&robot.at, phase4, rest);
+        let (ea, eb) = (expand(&first, rest)?, expand(&last, rest)?);
         let generate_s = t0.elapsed().as_secs_f64();
         let mut tunnels = [0; 4];
         for e in plan.steps().iter().flatten() {
@@ -282,7 +312,8 @@ pub fn theorem3(
                 tunnels[k.clamp(1, 4) - 1] += 1;
             }
         }
-        let (mut meta_certified, mut certify_s) = (None, None);
+        let (mut meta_certified, mut atoms_certified, mut comb_utilisation, mut certify_s) =
+            (None, None, None, None);
         if m <= certify_up_to {
             let t1 = Instant::now();
             let opts = Options {
@@ -290,19 +321,91 @@ pub fn theorem3(
                 ..Options::lattice_only()
             };
             meta_certified = Some(certify::certify(&s, &opts)?.certified);
+            let ca = certify::certify(&ea, &Options::lattice_only())?.certified;
+            let cb = certify::certify(&eb, &Options::lattice_only())?.certified;
+            atoms_certified = Some(ca && cb);
             certify_s = Some(t1.elapsed().as_secs_f64());
+            if let Some(model) = &mechanics {
+                let opts = Options {
+                    model: Some(model.clone()),
+                    ..Options::default()
+                };
+                let mut worst: f64 = 0.0;
+                for sch in [&ea, &eb] {
+                    let r = certify::certify(sch, &opts)?;
+                    for st in &r.per_step {
+                        if let Some(&u) = st.metrics.get("max_utilisation") {
+                            worst = worst.max(u);
+                        }
+                    }
+                }
+                comb_utilisation = Some(worst);
+            }
         }
+        let count = |s: &crate::schedule::Schedule| -> usize {
+            s.steps.iter().map(|st| st.events.len()).sum()
+        };
         rows.push(Theorem3Row {
             metas: m,
             atoms: 8 * m,
             phase_steps: std::array::from_fn(|i| plan.phases[i].len()),
             tunnels,
+            comb_steps: ea.steps.len() + eb.steps.len(),
+            comb_operations: count(&ea) + count(&eb),
             meta_certified,
+            atoms_certified,
+            comb_utilisation,
             generate_s,
             certify_s,
         });
     }
     Ok(rows)
+}
+
+/// Detach events for the neighbouring pairs a 3D robot holds apart: a
+/// schedule starts with every neighbouring pair attached.
+fn detached_neighbours(
+    r: &crate::algorithms::comb::three_d::Robot3,
+) -> Vec<crate::schedule::Event> {
+    use crate::algorithms::comb::common_comb::MetaRobot;
+    let mut out = Vec::new();
+    for (a, &c) in r.at.iter().enumerate() {
+        for d in [
+            crate::lattice::Cell::new(1, 0, 0),
+            crate::lattice::Cell::new(0, 1, 0),
+            crate::lattice::Cell::new(0, 0, 1),
+        ] {
+            if let Some(b) = r.at_cell(c + d)
+                && !r.attached.contains(&(a.min(b), a.max(b)))
+            {
+                out.push(crate::schedule::Event::Detach {
+                    module: a as u32,
+                    other: b as u32,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Theorem 2's series against atoms n: meta-module steps of the whole
+/// reconfiguration, and the combing phases' parallel steps and atom
+/// operations.
+pub fn theorem3_series(rows: &[Theorem3Row]) -> [(&'static str, Vec<(f64, f64)>); 3] {
+    let pts = |f: fn(&Theorem3Row) -> usize| -> Vec<(f64, f64)> {
+        rows.iter().map(|r| (r.atoms as f64, f(r) as f64)).collect()
+    };
+    [
+        (
+            "meta-module steps, S to T",
+            pts(|r| r.phase_steps.iter().sum()),
+        ),
+        ("combing phases' parallel steps", pts(|r| r.comb_steps)),
+        (
+            "combing phases' atom operations",
+            pts(|r| r.comb_operations),
+        ),
+    ]
 }
 
 /// Least-squares fit of `ln y = a + b·ln x` (slope `b`, intercept `a`,

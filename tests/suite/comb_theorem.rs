@@ -344,3 +344,24 @@ fn theorem_2_schedules_in_3d_certify_at_the_meta_level_and_end_at_the_target() {
     // Tunnels of more than two turns occur (Algorithm 3's k ≤ 4).
     assert!(turns_seen.iter().any(|&k| k > 2), "{turns_seen:?}");
 }
+
+#[test]
+fn theorem_2s_combing_phases_certify_atom_by_atom_and_the_theorems_are_drawn() {
+    use reconfcheck::study::comb::theorem3;
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/cube-atom.toml");
+    let rows = theorem3(&[8, 16], 4, AtomRest::Contracted, 16, Some(model)).unwrap();
+    for r in &rows {
+        assert_eq!(r.atoms_certified, Some(true), "{} meta-modules", r.metas);
+        assert_eq!(r.meta_certified, Some(true));
+        let u = r.comb_utilisation.unwrap();
+        assert!(u > 0.0 && u < 1.0, "{u}");
+        assert!(r.comb_operations > 0 && r.comb_steps > 0);
+    }
+    #[cfg(feature = "render")]
+    {
+        let png = common::scratch("theorems-plot", "theorems.png");
+        reconfcheck::render::comb_figures::theorems(&[], &rows, &[], &png).unwrap();
+        let bytes = std::fs::read(&png).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000);
+    }
+}

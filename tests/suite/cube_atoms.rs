@@ -611,3 +611,97 @@ fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
         }
     }
 }
+
+#[test]
+fn a_free_robot_holds_its_heaviest_part_and_the_arm_drags_the_lighter_mirror_too() {
+    // Six atoms in a row, none fixed; the first listed is the end atom
+    // whose arm pushes the other five away. Seen from it (the old frame),
+    // the arm would drag five atoms; on a table the five hold by their
+    // friction and the arm drags the one.
+    let text = std::fs::read_to_string(model()).unwrap();
+    let m = reconfcheck::mechanics::Model::from_toml(&text).unwrap();
+    let one = m.ground.friction * m.mass * m.gravity / m.connector.tension();
+    for mirror in [false, true] {
+        let x = |i: i32| if mirror { -i } else { i };
+        let atoms: Vec<(u32, [i32; 3], bool)> =
+            (0..6).map(|i| (i as u32, [x(i), 0, 0], false)).collect();
+        let face = if mirror { "-x" } else { "+x" };
+        let s = schedule(
+            "contracted",
+            &atoms,
+            json!([{"events": [{"op": "expand", "module": 0, "face": face}]}]),
+        );
+        let r = run(&s);
+        assert!(r.certified, "{}", r.summary());
+        let got = r.per_step[0].metrics["max_utilisation"];
+        assert!(
+            (got - one).abs() < 1e-12,
+            "mirror {mirror}: {got} vs {one} (one atom dragged)"
+        );
+        // Listed last, the pushing atom is dragged all the same.
+        let mut last = atoms.clone();
+        last.rotate_left(1);
+        let s = schedule(
+            "contracted",
+            &last,
+            json!([{"events": [{"op": "expand", "module": 0, "face": face}]}]),
+        );
+        let got = run(&s).per_step[0].metrics["max_utilisation"];
+        assert!(
+            (got - one).abs() < 1e-12,
+            "mirror {mirror}, listed last: {got}"
+        );
+    }
+}
+
+/// The 3D combing (seed 004 §3.2: 3D-COMBING to a terrain, then
+/// TERRAIN-TO-COMB) of a random polycube, as a meta-module schedule.
+fn comb3_schedule(m: usize, seed: u64) -> Schedule {
+    use rand::SeedableRng;
+    use reconfcheck::algorithms::comb::three_d::{Robot3, random_polycube, schedule_of};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let shape = random_polycube(m, &mut rng);
+    let mut r = Robot3::new(&shape);
+    r.comb();
+    schedule_of(&shape, r.steps, AtomRest::Contracted)
+}
+
+#[test]
+fn combing_random_polycubes_in_3d_certifies_atom_by_atom_in_place() {
+    // Chosen among the first seeds: (24, 4) carries meta-modules beside a
+    // slider's slice, across its lift (attached to all four of the
+    // slider's atoms on that face: an arm conflict before); the others
+    // have sliders with walls on two perpendicular sides (refused before).
+    let mut perpendicular = 0;
+    for (m, seed) in [(8, 5), (8, 8), (24, 1), (24, 4), (24, 5)] {
+        let s = comb3_schedule(m, seed);
+        for st in &s.steps {
+            let mut walls: std::collections::HashMap<u32, Vec<u32>> = Default::default();
+            for e in &st.events {
+                if let reconfcheck::schedule::Event::Slide {
+                    module,
+                    pivot: Some(p),
+                    ..
+                } = e
+                {
+                    walls.entry(*module).or_default().push(*p);
+                }
+            }
+            perpendicular += walls.values().filter(|w| w.len() > 1).count();
+        }
+        let r = run(&s);
+        assert!(
+            r.certified,
+            "{m} meta-modules, seed {seed}:\n{}",
+            r.summary()
+        );
+        assert!(r.checks.iter().any(|c| c.contains("in place")));
+        assert_eq!(r.per_step.len(), r.steps);
+        assert!(
+            r.per_step
+                .iter()
+                .any(|st| st.metrics["max_utilisation"] > 0.0)
+        );
+    }
+    assert!(perpendicular > 0, "no slider with two walls was exercised");
+}

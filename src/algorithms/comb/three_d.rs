@@ -463,12 +463,23 @@ pub fn schedule_of(
     steps: Vec<Vec<Event>>,
     rest: crate::lattice::AtomRest,
 ) -> crate::schedule::Schedule {
+    let at: Vec<Cell> = start.iter().copied().collect();
+    schedule_at(&at, steps, rest)
+}
+
+/// [`schedule_of`] from meta-module `k` at `at[k]` (a robot in the middle
+/// of a run, its ids kept).
+pub fn schedule_at(
+    at: &[Cell],
+    steps: Vec<Vec<Event>>,
+    rest: crate::lattice::AtomRest,
+) -> crate::schedule::Schedule {
     let mut s = crate::schedule::Schedule::new(
         crate::lattice::LatticeKind::Cubic,
         crate::schedule::Length::mm(120.0),
     );
     s.meta_modules = Some(rest);
-    s.modules = start
+    s.modules = at
         .iter()
         .enumerate()
         .map(|(k, &cell)| crate::schedule::ModuleSpec {
