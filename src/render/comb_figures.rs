@@ -64,27 +64,16 @@ pub fn theorems(
 ) -> Result<(), Error> {
     let t1 = theorem_series(two);
     let t2 = theorem3_series(three);
+    let measured = |theorem: &str, (name, points): &(&str, Vec<(f64, f64)>)| Series {
+        name: format!("{theorem}: {name}"),
+        points: points.clone(),
+        hollow: false,
+    };
     let data = vec![
-        Series {
-            name: format!("Theorem 1, 2D: {}", t1[0].0),
-            points: t1[0].1.clone(),
-            hollow: false,
-        },
-        Series {
-            name: format!("Theorem 1, 2D: {}", t1[3].0),
-            points: t1[3].1.clone(),
-            hollow: false,
-        },
-        Series {
-            name: format!("Theorem 2, 3D: {}", t2[0].0),
-            points: t2[0].1.clone(),
-            hollow: false,
-        },
-        Series {
-            name: format!("Theorem 2, 3D: {}", t2[2].0),
-            points: t2[2].1.clone(),
-            hollow: false,
-        },
+        measured("Theorem 1, 2D", &t1[0]),
+        measured("Theorem 1, 2D", &t1[3]),
+        measured("Theorem 2, 3D", &t2[0]),
+        measured("Theorem 2, 3D", &t2[2]),
         Series {
             name: "naive baseline (2D combing, one at a time): atom operations".into(),
             points: naive.to_vec(),
