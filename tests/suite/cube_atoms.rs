@@ -705,3 +705,75 @@ fn combing_random_polycubes_in_3d_certifies_atom_by_atom_in_place() {
     }
     assert!(perpendicular > 0, "no slider with two walls was exercised");
 }
+
+/// A SLIDE carrying a tower: a static row of `row` meta-modules at
+/// z = 0 (x = 1 − row … 1; B at x = 1, C at x = 0), the slider A on B at
+/// (1, 0, 1) sliding −x onto C, and `k` meta-modules stacked on A (its
+/// far side from the wall), carried. No meta-module is fixed. `mirror`
+/// flips x.
+fn carried_tower(row: i32, k: i32, mirror: bool) -> Value {
+    let x = |v: i32| if mirror { -v } else { v };
+    let mut metas: Vec<(u32, [i32; 3], bool)> = (0..row)
+        .map(|i| (i as u32, [x(1 - i), 0, 0], false))
+        .collect();
+    let a = row as u32;
+    metas.push((a, [x(1), 0, 1], false));
+    let slide = |id: u32, z: i32| json!({"op": "slide", "module": id, "from": [x(1), 0, z], "to": [0, 0, z]});
+    let mut events = vec![slide(a, 1)];
+    events[0]["pivot"] = json!(0);
+    for j in 1..=k {
+        let id = a + j as u32;
+        metas.push((id, [x(1), 0, 1 + j], false));
+        events.push(slide(id, 1 + j));
+    }
+    meta_doc(&metas, json!([{"events": events}]))
+}
+
+#[test]
+fn a_slides_drive_load_grows_with_what_it_carries_and_overloads_past_29_meta_modules() {
+    // Closed form, independent of the drive-load code: in the SLIDE's
+    // second step the slider's two contracting arms (one per layer, in
+    // parallel) pull its other six atoms and everything it carries, 8k
+    // atoms, while the static row (heavier) holds: each arm carries
+    // μ·m·g·(6 + 8k)/2. At 36 N faces and 100 g atoms on friction 0.3 it
+    // holds up to k = 29 (35.0 N) and not at k = 30 (36.2 N): the paper's
+    // O(1) SLIDE carrying any number of meta-modules meets a load limit.
+    let text = std::fs::read_to_string(model()).unwrap();
+    let m = reconfcheck::mechanics::Model::from_toml(&text).unwrap();
+    let per_atom = m.ground.friction * m.mass * m.gravity / m.connector.tension();
+    for (k, holds, mirror) in [
+        (1, true, false),
+        (5, true, true),
+        (29, true, false),
+        (29, true, true),
+        (30, false, false),
+        (30, false, true),
+    ] {
+        let doc = carried_tower(40, k, mirror);
+        let s = Schedule::from_json(&doc.to_string(), Path::new("t.json")).unwrap();
+        let r = run(&s);
+        let worst = r
+            .per_step
+            .iter()
+            .map(|st| st.metrics["max_utilisation"])
+            .fold(0.0, f64::max);
+        let expected = per_atom * (6 + 8 * k) as f64 / 2.0;
+        assert!(
+            (worst - expected).abs() < 1e-12,
+            "k = {k}, mirror {mirror}: {worst} vs {expected}"
+        );
+        assert_eq!(
+            r.certified,
+            holds,
+            "k = {k}, mirror {mirror}:\n{}",
+            r.summary()
+        );
+        if !holds {
+            assert!(
+                kinds(&r).iter().all(|&v| v == ViolationKind::Overload),
+                "{}",
+                r.summary()
+            );
+        }
+    }
+}
