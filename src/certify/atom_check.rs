@@ -226,8 +226,23 @@ impl AtomState {
         }
         let held = self.held(&plan);
         let bonds: Vec<Bond> = held.iter().map(|&p| self.bond_of(p)).collect();
+        // Which held bonds change length: the frame of a free robot and
+        // the drive loads both split the robot into rigid parts by them
+        // (neither needed: not computed).
+        let changing: Vec<bool> = if self.floating || checks.is_some_and(|c| c.mechanics.is_some())
+        {
+            bonds
+                .iter()
+                .map(|b| {
+                    plan.toggled.contains(&(b.a, b.face))
+                        || plan.toggled.contains(&(b.b, b.face.opposite()))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let end = match solve_step(&self.pos, &plan.ext1, &bonds, &self.anchors) {
-            Ok(end) if self.floating => self.hold_heaviest(end, &held, &plan),
+            Ok(end) if self.floating => self.hold_heaviest(end, &held, &changing),
             Ok(end) => end,
             Err(c) => {
                 out.violations.push(
@@ -254,7 +269,7 @@ impl AtomState {
             self.collisions(k, &end, &plan, &active, ch.epsilon, &mut out);
             self.in_place(k, &end, &plan, &active, ch, &mut out);
             if let Some(m) = &ch.mechanics {
-                self.mechanics(k, &held, &plan, m, &mut out);
+                self.mechanics(k, &held, &changing, m, &mut out);
             }
         }
         // Attaches at the end of the step: the faces must touch then.
@@ -286,17 +301,6 @@ impl AtomState {
         out
     }
 
-    /// Which held bonds change length in the step (an arm between them
-    /// expands or contracts).
-    fn changing(&self, held: &[(usize, usize)], plan: &AtomPlan) -> Vec<bool> {
-        held.iter()
-            .map(|&(a, b)| {
-                let f = self.bond_of((a, b)).face;
-                plan.toggled.contains(&(a, f)) || plan.toggled.contains(&(b, f.opposite()))
-            })
-            .collect()
-    }
-
     /// A robot with no fixed atom, in a step solved from an arbitrary
     /// anchor: the step's motion seen from its heaviest rigid part (the
     /// most atoms joined by bonds whose length does not change; ties: the
@@ -310,17 +314,9 @@ impl AtomState {
         &mut self,
         end: Vec<Cell>,
         held: &[(usize, usize)],
-        plan: &AtomPlan,
+        changing: &[bool],
     ) -> Vec<Cell> {
-        let changing = self.changing(held, plan);
-        let n = self.pos.len();
-        let mut parts = petgraph::unionfind::UnionFind::<usize>::new(n);
-        for (&(a, b), &c) in held.iter().zip(&changing) {
-            if !c {
-                parts.union(a, b);
-            }
-        }
-        let labels = parts.into_labeling();
+        let labels = crate::mechanics::atom::rigid_parts(self.pos.len(), held, changing);
         let mut size: FxHashMap<usize, (usize, usize)> = FxHashMap::default();
         for (a, &l) in labels.iter().enumerate() {
             size.entry(l).or_insert((0, a)).0 += 1;
@@ -492,11 +488,10 @@ impl AtomState {
         &self,
         k: usize,
         held: &[(usize, usize)],
-        plan: &AtomPlan,
+        changing: &[bool],
         m: &AtomMechanics,
         out: &mut StepFindings,
     ) {
-        let changing = self.changing(held, plan);
         if !changing.iter().any(|&c| c) {
             out.max_utilisation = Some(0.0);
             return;
@@ -504,7 +499,7 @@ impl AtomState {
         let loads = crate::mechanics::atom::drive_loads(
             self.pos.len(),
             held,
-            &changing,
+            changing,
             self.anchors[0],
             m.drag,
         );

@@ -113,12 +113,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
                 r.certified.map_or("-".into(), |c| c.to_string()),
             );
         }
-        for (name, pts) in study::series(&rows) {
-            let fit = study::loglog_fit(&pts).map_or("-".to_string(), |f| {
-                format!("slope {:.3}, R² {:.3}", f.slope, f.r2)
-            });
-            println!("{name} vs n: {fit}");
-        }
+        print_fits(&study::series(&rows), "");
         #[cfg(feature = "render")]
         if let Some(p) = &a.plot {
             reconfcheck::render::comb_figures::scaling(&rows, rest, p)?;
@@ -166,12 +161,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             r.certify_s.map_or("-".into(), |s| format!("{s:.2}")),
         );
     }
-    for (name, pts) in study::theorem_series(&theorem) {
-        let fit = study::loglog_fit(&pts).map_or("-".to_string(), |f| {
-            format!("slope {:.3}, R² {:.3}", f.slope, f.r2)
-        });
-        println!("{name} vs n: {fit}");
-    }
+    print_fits(&study::theorem_series(&theorem), "");
     let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/cube-atom.toml");
     let three = study::theorem3(
         &a.sizes,
@@ -221,12 +211,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             r.certify_s.map_or("-".into(), |s| format!("{s:.2}")),
         );
     }
-    for (name, pts) in study::theorem3_series(&three) {
-        let fit = study::loglog_fit(&pts).map_or("-".to_string(), |f| {
-            format!("slope {:.3}, R² {:.3}", f.slope, f.r2)
-        });
-        println!("{name}, 3D vs n: {fit}");
-    }
+    print_fits(&study::theorem3_series(&three), ", 3D");
     #[cfg(feature = "render")]
     if let Some(p) = &a.theorem_plot {
         let naive = all
@@ -247,4 +232,15 @@ pub fn run(a: Args) -> Result<u8, Error> {
         write_file(p, serde_json::to_string_pretty(&v).expect("serialises"))?;
     }
     Ok(0)
+}
+
+/// One line per series: its log–log fit against n (`-` when it has too
+/// few positive points).
+fn print_fits(series: &[(&str, Vec<(f64, f64)>)], label: &str) {
+    for (name, pts) in series {
+        let fit = study::loglog_fit(pts).map_or("-".to_string(), |f| {
+            format!("slope {:.3}, R² {:.3}", f.slope, f.r2)
+        });
+        println!("{name}{label} vs n: {fit}");
+    }
 }

@@ -28,6 +28,19 @@ pub struct DriveLoad {
     pub force: f64,
 }
 
+/// The rigid parts of a step: each atom's part, the atoms joined by the
+/// held `bonds` whose length does not change (`changing[k]` false), by
+/// union–find (petgraph's). Part labels are arbitrary.
+pub fn rigid_parts(n: usize, bonds: &[(usize, usize)], changing: &[bool]) -> Vec<usize> {
+    let mut parts = petgraph::unionfind::UnionFind::<usize>::new(n);
+    for (&(a, b), &c) in bonds.iter().zip(changing) {
+        if !c {
+            parts.union(a, b);
+        }
+    }
+    parts.into_labeling()
+}
+
 /// The drive loads of one step. `bonds`: the attachments held through the
 /// step (atom pairs); `changing[k]`: whether bond `k`'s length changes;
 /// `anchor`: an atom that stays; `drag`: the friction force of one atom
@@ -39,24 +52,7 @@ pub fn drive_loads(
     anchor: usize,
     drag: f64,
 ) -> Vec<DriveLoad> {
-    // Rigid parts: union–find over the bonds that do not change.
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for (k, &(a, b)) in bonds.iter().enumerate() {
-        if !changing[k] {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb {
-                parent[ra] = rb;
-            }
-        }
-    }
-    let part: Vec<usize> = (0..n).map(|x| find(&mut parent, x)).collect();
+    let part = rigid_parts(n, bonds, changing);
     let mut size: FxHashMap<usize, usize> = FxHashMap::default();
     for &p in &part {
         *size.entry(p).or_default() += 1;

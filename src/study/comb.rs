@@ -150,26 +150,7 @@ pub fn theorem(
         for es in plan.phases[..3].iter().flatten() {
             robot.apply(es);
         }
-        // A schedule starts with every neighbouring pair attached: first
-        // let go of the pairs the robot has detached by then.
-        let loose: Vec<Event> = {
-            let mut v: Vec<(usize, usize)> = Vec::new();
-            for (a, &(x, y)) in robot.at.iter().enumerate() {
-                for n in [(x + 1, y), (x, y + 1)] {
-                    if let Some(b) = robot.get(n)
-                        && !robot.attached.contains(&(a.min(b), a.max(b)))
-                    {
-                        v.push((a, b));
-                    }
-                }
-            }
-            v.into_iter()
-                .map(|(a, b)| Event::Detach {
-                    module: a as u32,
-                    other: b as u32,
-                })
-                .collect()
-        };
+        let loose = detached_neighbours(&robot);
         let mut phase4 = plan.phases[3].clone();
         if !loose.is_empty() {
             phase4.insert(0, loose);
@@ -190,14 +171,8 @@ pub fn theorem(
         let (mut meta_certified, mut atoms_certified, mut certify_s) = (None, None, None);
         if m <= certify_up_to {
             let t1 = Instant::now();
-            let opts = Options {
-                meta_level: true,
-                ..Options::lattice_only()
-            };
-            meta_certified = Some(certify::certify(&whole, &opts)?.certified);
-            let ca = certify::certify(&a, &Options::lattice_only())?.certified;
-            let cb = certify::certify(&b, &Options::lattice_only())?.certified;
-            atoms_certified = Some(ca && cb);
+            let (meta, atoms) = certify_phases(&whole, [&a, &b])?;
+            (meta_certified, atoms_certified) = (Some(meta), Some(atoms));
             certify_s = Some(t1.elapsed().as_secs_f64());
         }
         let count = |s: &crate::schedule::Schedule| -> usize {
@@ -316,14 +291,8 @@ pub fn theorem3(
             (None, None, None, None);
         if m <= certify_up_to {
             let t1 = Instant::now();
-            let opts = Options {
-                meta_level: true,
-                ..Options::lattice_only()
-            };
-            meta_certified = Some(certify::certify(&s, &opts)?.certified);
-            let ca = certify::certify(&ea, &Options::lattice_only())?.certified;
-            let cb = certify::certify(&eb, &Options::lattice_only())?.certified;
-            atoms_certified = Some(ca && cb);
+            let (meta, atoms) = certify_phases(&s, [&ea, &eb])?;
+            (meta_certified, atoms_certified) = (Some(meta), Some(atoms));
             certify_s = Some(t1.elapsed().as_secs_f64());
             if let Some(model) = &mechanics {
                 let opts = Options {
@@ -362,21 +331,36 @@ pub fn theorem3(
     Ok(rows)
 }
 
-/// Detach events for the neighbouring pairs a 3D robot holds apart: a
-/// schedule starts with every neighbouring pair attached.
-fn detached_neighbours(
-    r: &crate::algorithms::comb::three_d::Robot3,
+/// The whole schedule certified at the meta-module level, and the
+/// combing phases (expanded into atoms) atom by atom.
+fn certify_phases(
+    whole: &crate::schedule::Schedule,
+    phases: [&crate::schedule::Schedule; 2],
+) -> Result<(bool, bool), InputError> {
+    let opts = Options {
+        meta_level: true,
+        ..Options::lattice_only()
+    };
+    let meta = certify::certify(whole, &opts)?.certified;
+    let mut atoms = true;
+    for p in phases {
+        atoms &= certify::certify(p, &Options::lattice_only())?.certified;
+    }
+    Ok((meta, atoms))
+}
+
+/// Detach events for the neighbouring pairs a robot (2D or 3D) holds
+/// apart: a schedule starts with every neighbouring pair attached.
+fn detached_neighbours<R: crate::algorithms::comb::common_comb::MetaRobot>(
+    r: &R,
 ) -> Vec<crate::schedule::Event> {
-    use crate::algorithms::comb::common_comb::MetaRobot;
+    use crate::lattice::Cell;
     let mut out = Vec::new();
-    for (a, &c) in r.at.iter().enumerate() {
-        for d in [
-            crate::lattice::Cell::new(1, 0, 0),
-            crate::lattice::Cell::new(0, 1, 0),
-            crate::lattice::Cell::new(0, 0, 1),
-        ] {
+    for a in 0..r.count() {
+        let c = r.cell_of(a);
+        for d in [Cell::new(1, 0, 0), Cell::new(0, 1, 0), Cell::new(0, 0, 1)] {
             if let Some(b) = r.at_cell(c + d)
-                && !r.attached.contains(&(a.min(b), a.max(b)))
+                && !r.attached().contains(&(a.min(b), a.max(b)))
             {
                 out.push(crate::schedule::Event::Detach {
                     module: a as u32,
