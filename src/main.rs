@@ -53,6 +53,10 @@ enum Command {
     /// Seed 004: SLIDE costs derived by search, and the 2D combing's
     /// parallel steps and atom operations against n (log–log fits).
     CombStudy(cli::comb::Args),
+    /// Seed 004: search the stored atom sequences again (the expanded
+    /// model's SLIDE, about a minute) and write them to
+    /// models/moves/, or check the stored ones (--check).
+    DeriveMoves(cli::moves::Args),
     /// Seed 003 §V-B1: active subtraction on random configurations of
     /// several densities; prints a table and draws a box plot.
     DensityStudy(cli::density::Args),
@@ -114,6 +118,7 @@ fn dispatch(cmd: Command) -> Result<u8, Error> {
         Command::DockingStudy(a) => cli::docking::run(a),
         Command::RepostStudy(a) => cli::repost::run(a),
         Command::CombStudy(a) => cli::comb::run(a),
+        Command::DeriveMoves(a) => cli::moves::run(a),
         Command::Rules { json } => {
             let t = reconfcheck::geometry::table();
             print!("{}", t.to_text());

@@ -78,7 +78,9 @@ pub fn run(a: Args) -> Result<u8, Error> {
     }
     println!("k-TUNNEL for k > 1 and in the expanded model: not derived (see docs/atoms.md)");
     let mut all = Vec::new();
-    // The expanded model has no derived SLIDE (docs/atoms.md).
+    // The expanded model has no SLIDE between two walls (docs/atoms.md),
+    // which most larger combings need: its combing is certified where it
+    // needs none (tests), not studied against n.
     for rest in [AtomRest::Contracted] {
         let rows = study::run(&a.sizes, a.seed, rest, a.certify_up_to)?;
         println!(

@@ -11,6 +11,7 @@ pub mod docking;
 pub mod figures;
 pub mod html;
 pub mod interop;
+pub mod moves;
 pub mod output;
 pub mod parallel;
 #[cfg(feature = "render")]

@@ -4,7 +4,8 @@
 //!
 //! * `slide` with a `pivot` (the wall B; C is the meta-module beside B in
 //!   the slide direction): the SLIDE that [`crate::geometry::atom_search`]
-//!   derives, turned to the move's direction and wall by the lattice
+//!   derives (the expanded model's stored by
+//!   [`crate::geometry::stored_move`] and replayed on load), turned to the move's direction and wall by the lattice
 //!   symmetry that maps the canonical slide (−x along a wall at −y) onto it.
 //!   Every slide of one meta-level step runs in lockstep, shifted so that
 //!   the steps in which their carried meta-modules move coincide. A wall
@@ -73,44 +74,82 @@ impl SlideLibrary {
             None => (8..12).filter_map(|a| moves(a).next_back()).max(),
         }
     }
+
+    /// How far the carried meta-modules have travelled along the slide
+    /// after each step (index 0: the start; in atom lengths, ending at one
+    /// meta cell): the scene's carried atoms' track where it has them (the
+    /// expanded SLIDE moves them in two steps, half a cell each), else
+    /// the whole cell in [`Self::carrier_step`].
+    pub fn carried_travel(&self) -> Vec<i32> {
+        let last = self.track.len() - 1;
+        let along = |t: usize, a: usize| self.track[0][a].x - self.track[t][a].x;
+        match self.carried.first() {
+            Some(&a) => (0..=last).map(|t| along(t, a)).collect(),
+            None => {
+                let step = self.carrier_step().unwrap_or(0);
+                (0..=last)
+                    .map(|t| if t <= step { 0 } else { along(last, 8) })
+                    .collect()
+            }
+        }
+    }
 }
 
-/// The SLIDE between two walls, searched once per process.
+/// The SLIDE between two walls, searched once per process; `None` for the
+/// expanded model (none found within 311,324 states: each wall needs a
+/// holder row of its own, docs/atoms.md), so that a schedule needing it
+/// is refused at once rather than after a search.
 pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
-    static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
-    library(rest, [&CONTRACTED, &EXPANDED], || {
-        (super::atom_search::double_slide_problem(rest), Vec::new())
+    if rest == AtomRest::Expanded {
+        return None;
+    }
+    library(rest, &CONTRACTED, || {
+        let problem = super::atom_search::double_slide_problem(rest);
+        let found = problem.solve()?;
+        Some((problem, Vec::new(), found))
     })
 }
 
-/// The library of `rest`, searched once per process.
+/// The SLIDE of `rest`: the contracted model's searched once per process;
+/// the expanded model's read from its stored file and validated by replay
+/// ([`super::stored_move`]; its search takes about a minute), `None` if
+/// the stored sequence fails that replay.
 pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
     static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
-    library(rest, [&CONTRACTED, &EXPANDED], || {
-        let (problem, label) = slide_problem(rest, Carry::Both);
-        let carried = (0..label.len())
+    let carried = |label: &[char]| {
+        (0..label.len())
             .filter(|&a| matches!(label[a], 'D' | 'E'))
-            .collect();
-        (problem, carried)
-    })
+            .collect()
+    };
+    match rest {
+        AtomRest::Contracted => library(rest, &CONTRACTED, || {
+            let (problem, label) = slide_problem(rest, Carry::Both);
+            let found = problem.solve()?;
+            Some((problem, carried(&label), found))
+        }),
+        // Validated alone and carrying one behind; the scene behind gives
+        // the carried track. A load on the far side needs a relatch,
+        // which the lockstep adds (it travels unlike the top atom that
+        // drops into the bottom row).
+        AtomRest::Expanded => library(rest, &EXPANDED, || {
+            let (problem, found) = super::stored_move::expanded_slide(Carry::Behind).ok()?;
+            let (_, label) = slide_problem(rest, Carry::Behind);
+            Some((problem, carried(&label), found))
+        }),
+    }
 }
 
-/// Solves `problem` once per process and model (`cells`: the contracted
-/// and the expanded model's slot) and lifts the result to 3D.
+/// Makes a slide library once per process (`cell`: its slot) from its
+/// problem, carried atoms and sequence, and lifts the sequence to 3D.
 fn library(
     rest: AtomRest,
-    cells: [&'static OnceLock<Option<SlideLibrary>>; 2],
-    problem: impl FnOnce() -> (Problem, Vec<usize>),
+    cell: &'static OnceLock<Option<SlideLibrary>>,
+    make: impl FnOnce() -> Option<(Problem, Vec<usize>, Found)>,
 ) -> Option<&'static SlideLibrary> {
-    let cell = match rest {
-        AtomRest::Contracted => cells[0],
-        AtomRest::Expanded => cells[1],
-    };
     cell.get_or_init(|| {
-        let (problem, carried) = problem();
-        let found = problem.solve()?;
+        let (problem, carried, found) = make()?;
         let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
         let mut scene = problem.start.clone();
         let mut track = vec![scene.pos.clone()];
@@ -293,8 +332,9 @@ struct Plan {
     lateral: Vec<(ModuleId, ModuleId)>,
     /// The sliding meta-module (a SLIDE's).
     mover: Option<ModuleId>,
-    /// The step in which the meta-modules it carries move (a SLIDE's).
-    carrier: Option<usize>,
+    /// How far the meta-modules it carries have travelled after each step
+    /// (a SLIDE's; [`SlideLibrary::carried_travel`] in this run's order).
+    load: Option<Vec<i32>>,
     /// The mover's atoms, each with its offset from its start after each
     /// step (a SLIDE's; a tunnel's atoms are its library's business).
     motion: Vec<(ModuleId, Vec<Cell>)>,
@@ -302,9 +342,12 @@ struct Plan {
 
 /// The moves of one meta-level step run together, as atom steps.
 ///
-/// Every SLIDE's carried meta-modules move in one of its steps, all
-/// together, one cell (the derived SLIDE's second step; the first when it
-/// runs backwards): the moves are shifted so that those steps coincide.
+/// Every SLIDE's carried meta-modules move together, along the slide, in
+/// one of its steps (the contracted SLIDE's second; the first when it runs
+/// backwards) or two (the expanded SLIDE's, half a cell each): the moves
+/// are shifted so that the first steps in which their loads move
+/// coincide, and every carried meta-module travels as the load of the
+/// slide latest to start moving its load.
 /// Then any attached pair of atoms of two different moving meta-modules
 /// (sliders or carried) that would travel differently, for instance a
 /// meta-module carried beside the slider's slice, across the lift, is
@@ -322,10 +365,18 @@ fn in_lockstep(
     by_cell: &FxHashMap<Cell, ModuleId>,
     bonds: &FxHashSet<(ModuleId, ModuleId)>,
 ) -> Vec<Vec<Event>> {
-    let carrier = plans.iter().filter_map(|p| p.carrier).max().unwrap_or(0);
-    let shift: Vec<usize> = plans
+    let starts: Vec<Option<usize>> = plans
         .iter()
-        .map(|p| p.carrier.map_or(0, |c| carrier - c))
+        .map(|p| {
+            p.load
+                .as_ref()
+                .and_then(|l| (0..l.len() - 1).find(|&t| l[t + 1] != l[t]))
+        })
+        .collect();
+    let carrier = starts.iter().flatten().copied().max().unwrap_or(0);
+    let shift: Vec<usize> = starts
+        .iter()
+        .map(|c| c.map_or(0, |c| carrier - c))
         .collect();
     let len = plans
         .iter()
@@ -350,12 +401,24 @@ fn in_lockstep(
         }
     }
     movers.extend(plans.iter().filter_map(|p| p.mover));
+    // The load of the slide whose load starts latest, on the global clock.
+    let lead = (0..plans.len()).find(|&i| starts[i] == Some(carrier));
+    let load: Vec<(i32, i32)> = (0..=len)
+        .map(|t| match lead {
+            Some(i) => {
+                let l = plans[i].load.as_ref().expect("a load");
+                let full = *l.last().expect("a step");
+                (l[t.saturating_sub(shift[i]).min(l.len() - 1)], full)
+            }
+            None => (i32::from(t > carrier), 1),
+        })
+        .collect();
     for &(m, d) in carried {
         for &a in &owner[&m] {
             travel.insert(
                 a,
-                (0..=len)
-                    .map(|t| if t <= carrier { Cell::ZERO } else { d })
+                load.iter()
+                    .map(|&(x, full)| Cell::new(d.x * x / full, d.y * x / full, d.z * x / full))
                     .collect(),
             );
         }
@@ -687,7 +750,7 @@ fn expand_tracked(
                             .collect(),
                         lateral: Vec::new(),
                         mover: None,
-                        carrier: None,
+                        load: None,
                         motion: Vec::new(),
                     });
                     tunnelled.push(id);
@@ -843,9 +906,14 @@ fn expand_tracked(
                 steps,
                 lateral,
                 mover: Some(id),
-                carrier: lib
-                    .carrier_step()
-                    .map(|c| if back { last - 1 - c } else { c }),
+                load: Some({
+                    let l = lib.carried_travel();
+                    if back {
+                        l.iter().rev().map(|x| l[last] - x).collect()
+                    } else {
+                        l
+                    }
+                }),
                 motion,
             });
         }
@@ -934,7 +1002,7 @@ mod tests {
         let ids: Vec<ModuleId> = atoms.modules.iter().map(|m| m.id).collect();
         let ix = |m: ModuleId| ids.iter().position(|&i| i == m).unwrap();
         let pos: Vec<Cell> = atoms.modules.iter().map(|m| m.cell).collect();
-        let ext = vec![[false; 6]; pos.len()];
+        let ext = vec![[atoms.atoms == Some(AtomRest::Expanded); 6]; pos.len()];
         let mut scene = Scene {
             bonds: Scene::all_bonds(&pos, &ext),
             pos,
@@ -953,7 +1021,9 @@ mod tests {
                     _ => unreachable!(),
                 })
                 .collect();
-            scene = scene.step(&ops, &anchors, 1e-6).expect("a valid step");
+            scene = scene
+                .step(&ops, &anchors, 1e-6)
+                .unwrap_or_else(|| panic!("an invalid step: {ops:?}"));
         }
         ids.iter().copied().zip(scene.pos).collect()
     }
@@ -1033,6 +1103,76 @@ mod tests {
             // The derived moves exchange atoms between A and B, and the
             // legs' atoms move one cell along (docs/atoms.md).
             assert!(exchanged > 0);
+        }
+    }
+
+    #[test]
+    fn after_an_expanded_slide_every_meta_module_is_its_own_atoms_in_its_new_cell() {
+        // A static row (x = 1, 0, −1 at z = 0; the last fixed), the slider
+        // A (3) on B (0) sliding −x onto C (1) carrying D (4) behind it and
+        // E (5) on it; then the same slide run backwards: A pushes P (6)
+        // ahead of it instead (P lets go of C before and holds the row's
+        // end after: the schedule's latches).
+        let m = |id: ModuleId, c: [i32; 3]| ModuleSpec {
+            id,
+            cell: Cell::new(c[0], c[1], c[2]),
+            fixed: id == 2,
+        };
+        let slide =
+            |id: ModuleId, from: [i32; 3], to: [i32; 3], pivot: Option<ModuleId>| Event::Slide {
+                module: id,
+                from: Cell::new(from[0], from[1], from[2]),
+                to: Cell::new(to[0], to[1], to[2]),
+                pivot,
+            };
+        let row = [
+            m(0, [1, 0, 0]),
+            m(1, [0, 0, 0]),
+            m(2, [-1, 0, 0]),
+            m(3, [1, 0, 1]),
+        ];
+        let loaded = (
+            [row.as_slice(), &[m(4, [2, 0, 1]), m(5, [1, 0, 2])]].concat(),
+            vec![
+                slide(3, [1, 0, 1], [0, 0, 1], Some(0)),
+                slide(4, [2, 0, 1], [1, 0, 1], None),
+                slide(5, [1, 0, 2], [0, 0, 2], None),
+            ],
+        );
+        let pushing = (
+            [row.as_slice(), &[m(6, [0, 0, 1])]].concat(),
+            vec![
+                slide(3, [1, 0, 1], [0, 0, 1], Some(0)),
+                slide(6, [0, 0, 1], [-1, 0, 1], None),
+            ],
+        );
+        let latch = |op: fn(ModuleId, ModuleId) -> Event, a, b| Step {
+            events: vec![op(a, b)],
+        };
+        for (k, (modules, events)) in [loaded, pushing].into_iter().enumerate() {
+            let detach = |module, other| Event::Detach { module, other };
+            let attach = |module, other| Event::Attach { module, other };
+            let mut s = Schedule::new(
+                crate::lattice::LatticeKind::Cubic,
+                crate::schedule::Length::mm(60.0),
+            );
+            s.meta_modules = Some(AtomRest::Expanded);
+            s.modules = modules;
+            s.steps = if k == 0 {
+                vec![Step { events }]
+            } else {
+                vec![latch(detach, 6, 1), Step { events }, latch(attach, 6, 2)]
+            };
+            let (atoms, owners, at) = expand_tracked(&s, AtomRest::Expanded).unwrap();
+            assert_eq!(atoms.steps.len(), 12 + 2 * k, "case {k}");
+            let end = replay(&atoms);
+            for (id, own) in &owners {
+                for (l, a) in own.iter().enumerate() {
+                    assert_eq!(*a, 8 * id + l as ModuleId, "a slide exchanges no atoms");
+                    let want = atoms_of(*id, at[id], 3).nth(l).unwrap().cell;
+                    assert_eq!(end[a], want, "case {k}: meta-module {id}, local atom {l}");
+                }
+            }
         }
     }
 

@@ -875,6 +875,24 @@ pub fn slide_problem(rest: crate::lattice::AtomRest, carry: Carry) -> (Problem, 
     (problem, label)
 }
 
+/// The expanded model's SLIDE scene: [`slide_problem`] with A allowed all
+/// four faces of the slice and A's atoms one exchange group. With only
+/// ±x and −y the breadth-first search exhausts the scene without a
+/// sequence: every bond inside A is at full length at rest, so a top atom
+/// drops into the bottom row only if the atom under it contracts its +y
+/// face (docs/atoms.md). Searched with [`EXPANDED_SLIDE_SEARCH`].
+pub fn expanded_slide_problem(carry: Carry) -> (Problem, Vec<char>) {
+    let (mut p, label) = slide_problem(crate::lattice::AtomRest::Expanded, carry);
+    p.faces = vec![Face::PosX, Face::NegX, Face::PosY, Face::NegY];
+    p.exchange = vec![(0..label.len()).filter(|&a| label[a] == 'A').collect()];
+    (p, label)
+}
+
+/// [`Problem::solve_bidirectional`]'s weight and state bound for
+/// [`expanded_slide_problem`] (found in 343,950 states, about a minute in
+/// release).
+pub const EXPANDED_SLIDE_SEARCH: (usize, usize) = (2, 600_000);
+
 /// The SLIDE of a lone meta-module between two walls (seed 004 Alg. 1: a
 /// moving wall component of one meta-module with stationary neighbours on
 /// both sides slides along both, so that the robot stays connected through

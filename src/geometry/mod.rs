@@ -13,6 +13,7 @@ pub(crate) mod fcc_sweep;
 pub mod ground;
 pub(crate) mod rolling;
 pub(crate) mod rules;
+pub mod stored_move;
 pub(crate) mod sweep;
 
 use crate::lattice::config::{Ground, ModuleId};

@@ -315,9 +315,9 @@ fn bad_atom_events_are_unusable_input_naming_file_step_and_module() {
 
 #[test]
 fn derived_slides_certify_in_both_models() {
-    // The expanded model's SLIDE is not found within the search's bounds
-    // (docs/atoms.md): only the contracted model is derived.
-    for rest in [AtomRest::Contracted] {
+    // The contracted model's SLIDE is searched here; the expanded
+    // model's is stored (models/moves), replayed and expanded.
+    for rest in [AtomRest::Contracted, AtomRest::Expanded] {
         for carry in Carry::ALL {
             let d = derive_slide(rest, carry)
                 .unwrap_or_else(|| panic!("no SLIDE found for {rest:?} {carry:?}"));
@@ -348,6 +348,36 @@ fn comb_schedule(m: usize, seed: u64, rest: AtomRest) -> Schedule {
     let mut r = Robot::new(&shape);
     r.comb();
     meta_schedule(&shape, &r.steps, rest)
+}
+
+#[test]
+fn combing_random_polyominoes_in_the_expanded_model_certifies_or_names_the_missing_double_wall_slide()
+ {
+    // The expanded model's SLIDE is stored (models/moves); its SLIDE
+    // between two walls is not derived, so a combing that needs one is
+    // refused naming it, and every other is certified atom by atom.
+    let (mut certified, mut refused) = (0, 0);
+    for seed in 0..8 {
+        let s = comb_schedule(10, seed, AtomRest::Expanded);
+        let opts = Options {
+            model: Some(model()),
+            ..Default::default()
+        };
+        match certify::certify(&s, &opts) {
+            Ok(r) => {
+                assert!(r.certified, "seed {seed}:\n{}", r.summary());
+                assert!(r.checks.iter().any(|c| c.contains("in place")));
+                certified += 1;
+            }
+            Err(e) => {
+                let e = e.to_string();
+                assert!(e.contains("between two walls"), "seed {seed}: {e}");
+                refused += 1;
+            }
+        }
+    }
+    eprintln!("expanded combing: {certified} certified, {refused} refused (two walls)");
+    assert!(certified >= 6, "{certified} certified");
 }
 
 #[test]
@@ -776,4 +806,112 @@ fn a_slides_drive_load_grows_with_what_it_carries_and_overloads_past_29_meta_mod
             );
         }
     }
+}
+
+/// An expanded-model SLIDE through the expansion: a static row of three
+/// (x = 1, 0, −1 at z = 0; B at x = 1, C at x = 0), the slider A on B
+/// sliding −x onto C, carrying D behind it (x = 2) and/or E on it (z = 2),
+/// or pushing P ahead of it from x = 0 to −1 (the SLIDE run backwards; P
+/// lets go of C in a step before and holds the row's end in a step
+/// after). No meta-module is fixed. `place` turns or mirrors the robot.
+fn expanded_slide_doc(load: Load, place: impl Fn([i32; 3]) -> [i32; 3]) -> Value {
+    let mut metas: Vec<(u32, [i32; 3], bool)> = (0..3)
+        .map(|i| (i, place([1 - i as i32, 0, 0]), false))
+        .collect();
+    let slide = |id: u32, from: [i32; 3], to: [i32; 3]| json!({"op": "slide", "module": id, "from": place(from), "to": place(to)});
+    metas.push((3, place([1, 0, 1]), false));
+    let mut events = vec![slide(3, [1, 0, 1], [0, 0, 1])];
+    events[0]["pivot"] = json!(0);
+    if load.behind {
+        metas.push((4, place([2, 0, 1]), false));
+        events.push(slide(4, [2, 0, 1], [1, 0, 1]));
+    }
+    if load.above {
+        metas.push((5, place([1, 0, 2]), false));
+        events.push(slide(5, [1, 0, 2], [0, 0, 2]));
+    }
+    let mut steps = vec![json!({"events": events})];
+    if load.ahead {
+        metas.push((6, place([0, 0, 1]), false));
+        steps[0]["events"]
+            .as_array_mut()
+            .unwrap()
+            .push(slide(6, [0, 0, 1], [-1, 0, 1]));
+        steps.insert(
+            0,
+            json!({"events": [{"op": "detach", "module": 6, "other": 1}]}),
+        );
+        steps.push(json!({"events": [{"op": "attach", "module": 6, "other": 2}]}));
+    }
+    let mut doc = meta_doc(&metas, Value::Array(steps));
+    doc["meta_modules"] = json!("expanded");
+    doc
+}
+
+/// Where a test robot's cells go (turned or mirrored).
+type Place = fn([i32; 3]) -> [i32; 3];
+
+#[derive(Clone, Copy, Debug)]
+struct Load {
+    behind: bool,
+    above: bool,
+    ahead: bool,
+}
+
+#[test]
+fn the_stored_expanded_slide_certifies_atom_by_atom_with_each_load_turned_and_mirrored() {
+    let places: [(&str, Place); 3] = [
+        ("as is", |c| c),
+        ("mirrored in x", |c| [-c[0], c[1], c[2]]),
+        ("turned (slide along y, wall below in z)", |c| {
+            [c[1], c[0], c[2]]
+        }),
+    ];
+    let l = |behind, above, ahead| Load {
+        behind,
+        above,
+        ahead,
+    };
+    for load in [
+        l(false, false, false),
+        l(true, false, false),
+        l(false, true, false),
+        l(true, true, false),
+        l(false, false, true),
+    ] {
+        for (name, place) in places {
+            let doc = expanded_slide_doc(load, place);
+            let s = Schedule::from_json(&doc.to_string(), Path::new("t.json")).unwrap();
+            let r = run(&s);
+            assert!(r.certified, "{load:?}, {name}:\n{}", r.summary());
+            // 12 parallel steps, 96 operations by the slider; a load on
+            // its far side lets go of the top atom that drops into the
+            // bottom row in the first step and latches again in the last;
+            // a load ahead lets go and latches in steps of its own.
+            let ops: usize = r
+                .per_step
+                .iter()
+                .map(|st| st.metrics["atom_operations"] as usize)
+                .sum();
+            let (above, ahead) = (usize::from(load.above), usize::from(load.ahead));
+            assert_eq!(r.steps, 12 + 2 * ahead, "{load:?}, {name}");
+            assert_eq!(ops, 96 + 4 * above + 8 * ahead, "{load:?}, {name}");
+        }
+    }
+    // Between two walls the expanded model has no derived SLIDE: refused.
+    let mut doc = expanded_slide_doc(l(false, false, false), |c| c);
+    doc["modules"].as_array_mut().unwrap().extend([
+        json!({"id": 7, "cell": [1, 0, 2], "fixed": false}),
+        json!({"id": 8, "cell": [0, 0, 2], "fixed": false}),
+    ]);
+    doc["steps"][0]["events"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"op": "slide", "module": 3, "from": [1, 0, 1], "to": [0, 0, 1], "pivot": 7}));
+    let (code, err) = cli_certify("two-walls.json", &doc);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("two-walls.json") && err.contains("two walls"),
+        "{err}"
+    );
 }

@@ -4,7 +4,8 @@
 //! naming the file or certified with a verdict — through every check,
 //! collision sweeps and mechanics included. The same for the shape files:
 //! character-level edits of a CSG file, of a 2D grid file and of a RePoSt
-//! meta-module shape file are refused or parsed; and for the scenarios: each generator's parameters, edited, are
+//! meta-module shape file are refused or parsed; an edited stored atom
+//! sequence (seed 004's expanded SLIDE) is refused or replays to its goal; and for the scenarios: each generator's parameters, edited, are
 //! refused or generate a schedule that is certified. `PROPTEST_CASES=20000 cargo test --test suite fuzz::` searches longer.
 
 use proptest::prelude::*;
@@ -384,6 +385,33 @@ proptest! {
         match outcome {
             Ok(Ok((m, again))) => prop_assert_eq!(Some(m), again),
             Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.txt"), "{e}"),
+            Err(_) => prop_assert!(false, "panicked on {edited:?}"),
+        }
+    }
+
+    /// The stored atom sequences of seed 004 (models/moves): an edited
+    /// expanded SLIDE is refused naming the file, or replays valid by the
+    /// certifier's step rules to the exact goal.
+    #[test]
+    fn edited_stored_moves_are_refused_or_replay_to_the_goal_never_a_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0usize..3, 0usize..1000), 1..6),
+    ) {
+        use reconfcheck::geometry::atom_search::{Carry, expanded_slide_problem};
+        use reconfcheck::geometry::stored_move::StoredMove;
+        let edited = edited_model("models/moves/slide-expanded.json", &edits);
+        let (p, _) = expanded_slide_problem(Carry::None);
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            StoredMove::parse(&edited, "edited.json").and_then(|m| m.validated(&p, "edited.json"))
+        }));
+        match outcome {
+            Ok(Ok(found)) => {
+                let mut s = p.start.clone();
+                for st in &found.steps {
+                    s = s.step(st, &p.anchors, p.eps).expect("validated steps replay");
+                }
+                prop_assert!(s == p.goal);
+            }
+            Ok(Err(e)) => prop_assert!(e.to_string().contains("edited.json"), "{e}"),
             Err(_) => prop_assert!(false, "panicked on {edited:?}"),
         }
     }
