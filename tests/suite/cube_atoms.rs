@@ -686,14 +686,57 @@ fn a_free_robot_holds_its_heaviest_part_and_the_arm_drags_the_lighter_mirror_too
 
 /// The 3D combing (seed 004 §3.2: 3D-COMBING to a terrain, then
 /// TERRAIN-TO-COMB) of a random polycube, as a meta-module schedule.
-fn comb3_schedule(m: usize, seed: u64) -> Schedule {
+fn comb3_schedule(m: usize, seed: u64, rest: AtomRest) -> Schedule {
     use rand::SeedableRng;
     use reconfcheck::algorithms::comb::three_d::{Robot3, random_polycube, schedule_of};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let shape = random_polycube(m, &mut rng);
     let mut r = Robot3::new(&shape);
     r.comb();
-    schedule_of(&shape, r.steps, AtomRest::Contracted)
+    schedule_of(&shape, r.steps, rest)
+}
+
+/// Sliders with walls on two perpendicular sides, over the schedule.
+fn perpendicular_walls(s: &Schedule) -> usize {
+    let mut n = 0;
+    for st in &s.steps {
+        let mut walls: std::collections::HashMap<u32, Vec<u32>> = Default::default();
+        for e in &st.events {
+            if let reconfcheck::schedule::Event::Slide {
+                module,
+                pivot: Some(p),
+                ..
+            } = e
+            {
+                walls.entry(*module).or_default().push(*p);
+            }
+        }
+        n += walls.values().filter(|w| w.len() > 1).count();
+    }
+    n
+}
+
+#[test]
+fn combing_random_polycubes_in_3d_in_the_expanded_model_certifies_atom_by_atom() {
+    // The stored expanded SLIDE with the 3D combing's hand-overs of walls
+    // across the lift (two sliders in (24, 1), one in (24, 6)) and loads
+    // beside the slice. Not all combings: (8, 5), (8, 8) and (24, 5) are
+    // rejected by the certifier (16 atoms disconnected in the middle of a
+    // slide): a fault of the expansion with this SLIDE in 3D, not yet
+    // found (docs/atoms.md).
+    let mut perpendicular = 0;
+    for (m, seed) in [(24, 1), (24, 4), (24, 6)] {
+        let s = comb3_schedule(m, seed, AtomRest::Expanded);
+        let r = run(&s);
+        assert!(
+            r.certified,
+            "{m} meta-modules, seed {seed}:\n{}",
+            r.summary()
+        );
+        assert!(r.checks.iter().any(|c| c.contains("in place")));
+        perpendicular += perpendicular_walls(&s);
+    }
+    assert!(perpendicular > 0, "no slider with two walls was exercised");
 }
 
 #[test]
@@ -704,21 +747,8 @@ fn combing_random_polycubes_in_3d_certifies_atom_by_atom_in_place() {
     // have sliders with walls on two perpendicular sides (refused before).
     let mut perpendicular = 0;
     for (m, seed) in [(8, 5), (8, 8), (24, 1), (24, 4), (24, 5)] {
-        let s = comb3_schedule(m, seed);
-        for st in &s.steps {
-            let mut walls: std::collections::HashMap<u32, Vec<u32>> = Default::default();
-            for e in &st.events {
-                if let reconfcheck::schedule::Event::Slide {
-                    module,
-                    pivot: Some(p),
-                    ..
-                } = e
-                {
-                    walls.entry(*module).or_default().push(*p);
-                }
-            }
-            perpendicular += walls.values().filter(|w| w.len() > 1).count();
-        }
+        let s = comb3_schedule(m, seed, AtomRest::Contracted);
+        perpendicular += perpendicular_walls(&s);
         let r = run(&s);
         assert!(
             r.certified,
