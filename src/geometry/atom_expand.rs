@@ -364,6 +364,7 @@ fn in_lockstep(
     at: &FxHashMap<ModuleId, Cell>,
     by_cell: &FxHashMap<Cell, ModuleId>,
     bonds: &FxHashSet<(ModuleId, ModuleId)>,
+    sp: i32,
 ) -> Vec<Vec<Event>> {
     let starts: Vec<Option<usize>> = plans
         .iter()
@@ -458,30 +459,54 @@ fn in_lockstep(
         });
     }
     // A wall across the lift: each of the slider's atoms on that face lets
-    // go of the wall B in the step it starts to move and holds C from the
-    // end of the step in which it stops, so the slider holds on to that
-    // side throughout by the atoms standing still.
+    // go of the wall in the step it starts to move, and whenever it stops
+    // facing an atom of B or C (the wall and the meta-module beside it
+    // along the slide), holds that atom until it moves again: the slider
+    // holds on to that side throughout by the atoms standing still. (The
+    // contracted SLIDE moves each atom in one step, from facing B to facing
+    // C; the expanded one moves its atoms in several, half a cell at a
+    // time, and between moves they face B's or C's other row.)
     for p in &plans {
         let Some(m) = p.mover else { continue };
         for &(b, c) in &p.lateral {
+            let across = at[&b] - at[&m];
+            let across = Cell::new(across.x * sp, across.y * sp, across.z * sp);
+            let wall: FxHashMap<Cell, ModuleId> = [b, c]
+                .iter()
+                .flat_map(|w| {
+                    atoms_of(*w, at[w], sp)
+                        .enumerate()
+                        .map(move |(l, a)| (a.cell, owner[w][l]))
+                })
+                .collect();
             for (la, lb) in face_pairs(at[&m], at[&b]).expect("a wall beside the slider") {
                 let a = owner[&m][la];
+                let Some(way) = travel.get(&a) else { continue };
+                let start = atoms_of(m, at[&m], sp).nth(la).expect("eight atoms").cell;
+                // A slider the schedule let go of this wall is left alone.
+                let mut held = Some(owner[&b][lb]);
                 if !bonds.contains(&pair_of(a, owner[&b][lb])) {
                     continue;
                 }
-                let Some(way) = travel.get(&a) else { continue };
-                let moving: Vec<usize> = (0..len).filter(|&t| way[t + 1] != way[t]).collect();
-                let (Some(&first), Some(&last)) = (moving.first(), moving.last()) else {
-                    continue;
-                };
-                steps[first].push(Event::Detach {
-                    module: a,
-                    other: owner[&b][lb],
-                });
-                steps[last].push(Event::Attach {
-                    module: a,
-                    other: owner[&c][lb],
-                });
+                for t in 0..len {
+                    if way[t + 1] == way[t] {
+                        continue;
+                    }
+                    if let Some(w) = held.take() {
+                        steps[t].push(Event::Detach {
+                            module: a,
+                            other: w,
+                        });
+                    }
+                    let still = t + 1 == len || way[t + 2] == way[t + 1];
+                    if let Some(&w) = wall.get(&(start + way[t + 1] + across)).filter(|_| still) {
+                        steps[t].push(Event::Attach {
+                            module: a,
+                            other: w,
+                        });
+                        held = Some(w);
+                    }
+                }
             }
         }
     }
@@ -930,7 +955,7 @@ fn expand_tracked(
             })
             .collect();
         out.steps.extend(
-            in_lockstep(slides, &carried, &owner, &at, &by_cell, &bonds)
+            in_lockstep(slides, &carried, &owner, &at, &by_cell, &bonds, sp)
                 .into_iter()
                 .map(|events| Step { events }),
         );
