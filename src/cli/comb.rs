@@ -78,10 +78,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
     }
     println!("k-TUNNEL for k > 1 and in the expanded model: not derived (see docs/atoms.md)");
     let mut all = Vec::new();
-    // The expanded model has no SLIDE between two walls (docs/atoms.md),
-    // which most larger combings need: its combing is certified where it
-    // needs none (tests), not studied against n.
-    for rest in [AtomRest::Contracted] {
+    for rest in [AtomRest::Contracted, AtomRest::Expanded] {
         let rows = study::run(&a.sizes, a.seed, rest, a.certify_up_to)?;
         println!(
             "\n2D COMBING, {rest:?} model (random polyominoes, seed {})",
@@ -115,13 +112,13 @@ pub fn run(a: Args) -> Result<u8, Error> {
                 r.certified.map_or("-".into(), |c| c.to_string()),
             );
         }
-        print_fits(&study::series(&rows), "");
-        #[cfg(feature = "render")]
-        if let Some(p) = &a.plot {
-            reconfcheck::render::comb_figures::scaling(&rows, rest, p)?;
-            println!("wrote {}", p.display());
-        }
+        print_fits(&study::series(&rows), &format!(", {rest:?}"));
         all.push((rest, rows));
+    }
+    #[cfg(feature = "render")]
+    if let Some(p) = &a.plot {
+        reconfcheck::render::comb_figures::scaling(&all, p)?;
+        println!("wrote {}", p.display());
     }
     let theorem = study::theorem(&a.sizes, a.seed, AtomRest::Contracted, a.certify_up_to)?;
     println!(

@@ -44,26 +44,33 @@ use std::sync::OnceLock;
 
 /// The SLIDE used for every slide: the 2D-slice search with both carried
 /// meta-modules present (valid, by construction, without them: they only
-/// add obstacles and never hold the robot together), lifted to 3D.
+/// add obstacles and never hold the robot together), lifted to 3D; or,
+/// between two walls in the expanded model, that model's SLIDE run one
+/// layer at a time ([`layered_double_slide`]).
 pub struct SlideLibrary {
-    pub problem: Problem,
+    /// The 2D-slice sequence the move is made of, as the search found it.
     pub found: Found,
-    /// The lifted steps; atom `q` of the lifted scene is atom `(q / 2) % 4`
-    /// of the 2D slice's meta-module `q / 8`, at height `q % 2`.
+    /// The 3D steps; atom `q` of the lifted scene is atom `(q / 2) % 4` of
+    /// the 2D slice's meta-module `q / 8`, at height `q % 2`.
     pub steps: Vec<Vec<Op>>,
-    /// Where each atom of the 2D slice is before the first step and after
-    /// each step (`track[t][a]`): how the slider's atoms move.
+    /// Where each atom of the lifted scene is before the first step and
+    /// after each step (`track[t][q]`): how the slider's atoms move.
     pub track: Vec<Vec<Cell>>,
-    /// The slice's carried atoms (the meta-modules behind and beside the
-    /// slider; none in the double slide's scene).
+    /// Lifted atoms whose track the carried meta-modules follow (the
+    /// scene's carried meta-modules; a layered SLIDE's last layer's
+    /// trailing atom); none: they move a whole cell in
+    /// [`Self::carrier_step`].
     pub carried: Vec<usize>,
 }
 
+/// The slider's atoms in a lifted slide scene (its third meta-module).
+const SLIDER: std::ops::Range<usize> = 16..24;
+
 impl SlideLibrary {
-    /// The step in which the carried meta-modules move (all at once, one
-    /// whole cell): in the scene's, where it has them (the single wall's
-    /// SLIDE); else the last step in which the slider's atoms move (between
-    /// two walls: the trailing column, which a meta-module behind it
+    /// The step in which the carried meta-modules start to move: the
+    /// first move of the atoms they follow, where the library has them;
+    /// else the last step in which the slider's atoms move (between two
+    /// walls: the trailing column, which a meta-module behind it
     /// touches).
     pub fn carrier_step(&self) -> Option<usize> {
         let moves = |a: usize| {
@@ -71,15 +78,15 @@ impl SlideLibrary {
         };
         match self.carried.first() {
             Some(&a) => moves(a).next(),
-            None => (8..12).filter_map(|a| moves(a).next_back()).max(),
+            None => SLIDER.filter_map(|a| moves(a).next_back()).max(),
         }
     }
 
     /// How far the carried meta-modules have travelled along the slide
     /// after each step (index 0: the start; in atom lengths, ending at one
-    /// meta cell): the scene's carried atoms' track where it has them (the
-    /// expanded SLIDE moves them in two steps, half a cell each), else
-    /// the whole cell in [`Self::carrier_step`].
+    /// meta cell): the track of the atoms they follow (the expanded SLIDE
+    /// moves them in two steps, half a cell each), else the whole cell in
+    /// [`Self::carrier_step`].
     pub fn carried_travel(&self) -> Vec<i32> {
         let last = self.track.len() - 1;
         let along = |t: usize, a: usize| self.track[0][a].x - self.track[t][a].x;
@@ -88,27 +95,117 @@ impl SlideLibrary {
             None => {
                 let step = self.carrier_step().unwrap_or(0);
                 (0..=last)
-                    .map(|t| if t <= step { 0 } else { along(last, 8) })
+                    .map(|t| {
+                        if t <= step {
+                            0
+                        } else {
+                            along(last, SLIDER.start)
+                        }
+                    })
                     .collect()
             }
         }
     }
+
+    /// Replays lifted `steps` from `start` (frame: `anchors`), recording
+    /// every atom's track; `None` if a step is invalid or the end is not
+    /// `goal` (when given).
+    fn replayed(
+        found: Found,
+        start: &Scene,
+        goal: Option<&Scene>,
+        steps: Vec<Vec<Op>>,
+        anchors: &[usize],
+        carried: Vec<usize>,
+    ) -> Option<SlideLibrary> {
+        let mut scene = start.clone();
+        let mut track = vec![scene.pos.clone()];
+        for st in &steps {
+            scene = scene.step(st, anchors, 1e-6)?;
+            track.push(scene.pos.clone());
+        }
+        if goal.is_some_and(|g| *g != scene) {
+            return None;
+        }
+        Some(SlideLibrary {
+            found,
+            steps,
+            track,
+            carried,
+        })
+    }
 }
 
-/// The SLIDE between two walls, searched once per process; `None` for the
-/// expanded model (none found within 311,324 states: each wall needs a
-/// holder row of its own, docs/atoms.md), so that a schedule needing it
-/// is refused at once rather than after a search.
+/// The SLIDE between two walls: the contracted model's searched once per
+/// process; the expanded model's composed from its one-wall SLIDE, one
+/// layer at a time ([`layered_double_slide`]), since no search found it.
 pub fn double_slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
     static CONTRACTED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
-    if rest == AtomRest::Expanded {
-        return None;
+    static EXPANDED: OnceLock<Option<SlideLibrary>> = OnceLock::new();
+    match rest {
+        AtomRest::Contracted => library(rest, &CONTRACTED, || {
+            let problem = super::atom_search::double_slide_problem(rest);
+            let found = problem.solve()?;
+            Some((problem, Vec::new(), found))
+        }),
+        AtomRest::Expanded => EXPANDED
+            .get_or_init(|| {
+                let (_, found) = super::stored_move::expanded_slide(Carry::None).ok()?;
+                layered_double_slide(found)
+            })
+            .as_ref(),
     }
-    library(rest, &CONTRACTED, || {
-        let problem = super::atom_search::double_slide_problem(rest);
-        let found = problem.solve()?;
-        Some((problem, Vec::new(), found))
-    })
+}
+
+/// The expanded SLIDE between two walls B (below) and B′ (above), made of
+/// the expanded one-wall SLIDE (`single`, on the slice's atoms B, C, A),
+/// run by one layer of the slider at a time: the slice search cannot find
+/// it (none within 311,324 states: each wall needs its own holder, and the
+/// lifted slice moves both layers alike). The top layer lets go of the
+/// bottom layer and of B′ and slides along B while the bottom layer holds
+/// both walls; it takes C′ on arrival; then the bottom layer lets go of
+/// B′ and slides, B′ hanging on C′ and the top layer; on arrival it takes
+/// C′ and the top layer again. 24 steps. Checked by replay against the
+/// lifted two-wall scene's goal here, and by the certifier wherever used.
+pub fn layered_double_slide(single: Found) -> Option<SlideLibrary> {
+    let rest = AtomRest::Expanded;
+    let sp = rest_spacing(rest);
+    let p = super::atom_search::double_slide_problem(rest);
+    let (start, _) = lift(&p.start, &[], sp);
+    let (goal, _) = lift(&p.goal, &[], sp);
+    let slider = 8..12;
+    let (b2, c2) = (20..24, 24..28);
+    let with = |bonds: &std::collections::BTreeSet<(usize, usize)>,
+                other: &std::ops::Range<usize>| {
+        bonds
+            .iter()
+            .copied()
+            .filter(|&(a, b)| slider.contains(&a) && other.contains(&b))
+            .collect::<Vec<_>>()
+    };
+    let (held, taken) = (with(&p.start.bonds, &b2), with(&p.goal.bonds, &c2));
+    let mut steps: Vec<Vec<Op>> = Vec::new();
+    for h in [1, 0] {
+        let on = |a: usize| 2 * a + h;
+        let mut run: Vec<Vec<Op>> = single
+            .steps
+            .iter()
+            .map(|st| st.iter().map(|op| op.renamed(on)).collect())
+            .collect();
+        let (first, last) = (0, run.len() - 1);
+        run[first].extend(held.iter().map(|&(a, b)| Op::Detach(on(a), on(b))));
+        run[last].extend(taken.iter().map(|&(a, c)| Op::Attach(on(a), on(c))));
+        let columns = slider.clone().map(|a| (2 * a, 2 * a + 1));
+        if h == 1 {
+            run[first].extend(columns.map(|(a, b)| Op::Detach(a, b)));
+        } else {
+            run[last].extend(columns.map(|(a, b)| Op::Attach(a, b)));
+        }
+        steps.extend(run);
+    }
+    let anchors: Vec<usize> = p.anchors.iter().flat_map(|&a| [2 * a, 2 * a + 1]).collect();
+    // Loads behind follow the bottom layer's trailing atom (slice atom 9).
+    SlideLibrary::replayed(single, &start, Some(&goal), steps, &anchors, vec![2 * 9])
 }
 
 /// The SLIDE of `rest`: the contracted model's searched once per process;
@@ -142,7 +239,7 @@ pub fn slide_library(rest: AtomRest) -> Option<&'static SlideLibrary> {
 }
 
 /// Makes a slide library once per process (`cell`: its slot) from its
-/// problem, carried atoms and sequence, and lifts the sequence to 3D.
+/// problem, carried atoms (of the slice) and sequence, lifted to 3D.
 fn library(
     rest: AtomRest,
     cell: &'static OnceLock<Option<SlideLibrary>>,
@@ -150,20 +247,14 @@ fn library(
 ) -> Option<&'static SlideLibrary> {
     cell.get_or_init(|| {
         let (problem, carried, found) = make()?;
-        let (_, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
-        let mut scene = problem.start.clone();
-        let mut track = vec![scene.pos.clone()];
-        for st in &found.steps {
-            scene = scene.step(st, &problem.anchors, problem.eps)?;
-            track.push(scene.pos.clone());
-        }
-        Some(SlideLibrary {
-            problem,
-            found,
-            steps,
-            track,
-            carried,
-        })
+        let (start, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
+        let anchors: Vec<usize> = problem
+            .anchors
+            .iter()
+            .flat_map(|&a| [2 * a, 2 * a + 1])
+            .collect();
+        let carried = carried.iter().map(|&a| 2 * a).collect();
+        SlideLibrary::replayed(found, &start, None, steps, &anchors, carried)
     })
     .as_ref()
 }
@@ -320,6 +411,16 @@ fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
     )
 }
 
+/// The six neighbouring cells' offsets.
+const SIX: [Cell; 6] = [
+    Cell::new(1, 0, 0),
+    Cell::new(-1, 0, 0),
+    Cell::new(0, 1, 0),
+    Cell::new(0, -1, 0),
+    Cell::new(0, 0, 1),
+    Cell::new(0, 0, -1),
+];
+
 fn pair_of(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
     if a < b { (a, b) } else { (b, a) }
 }
@@ -414,17 +515,67 @@ fn in_lockstep(
             None => (i32::from(t > carrier), 1),
         })
         .collect();
-    for &(m, d) in carried {
-        for &a in &owner[&m] {
-            travel.insert(
-                a,
-                load.iter()
-                    .map(|&(x, full)| Cell::new(d.x * x / full, d.y * x / full, d.z * x / full))
-                    .collect(),
-            );
+    // Each carried meta-module rides on the moving atoms it is attached
+    // to: of their travels that go straight along the slide to its goal,
+    // the load's own if one is, else the one most of its pairs share
+    // (between two walls in the expanded model a load beside the slice is
+    // attached to one layer, which moves while the other stands). A load
+    // attached only to other loads rides on theirs; one attached to none,
+    // on the load's.
+    let lead_way = |d: Cell| -> Vec<Cell> {
+        load.iter()
+            .map(|&(x, full)| Cell::new(d.x * x / full, d.y * x / full, d.z * x / full))
+            .collect()
+    };
+    let mut pending: Vec<(ModuleId, Cell)> = carried.to_vec();
+    loop {
+        let before = pending.len();
+        pending.retain(|&(m, d)| {
+            let own = lead_way(d);
+            let straight = |w: &Vec<Cell>| {
+                w.last() == Some(&d)
+                    && w.iter().all(|o| {
+                        o.x * d.y == o.y * d.x && o.x * d.z == o.z * d.x && o.y * d.z == o.z * d.y
+                    })
+            };
+            let mut votes: Vec<(&Vec<Cell>, usize)> = Vec::new();
+            for n in SIX.iter().filter_map(|&s| by_cell.get(&(at[&m] + s))) {
+                for (la, lb) in face_pairs(at[&m], at[n]).expect("neighbours") {
+                    let (a, b) = (owner[&m][la], owner[n][lb]);
+                    let Some(w) = travel.get(&b).filter(|w| straight(w)) else {
+                        continue;
+                    };
+                    if !bonds.contains(&pair_of(a, b)) {
+                        continue;
+                    }
+                    match votes.iter_mut().find(|(v, _)| *v == w) {
+                        Some((_, k)) => *k += 1,
+                        None => votes.push((w, 1)),
+                    }
+                }
+            }
+            let way = if votes.iter().any(|(w, _)| **w == own) {
+                own
+            } else if let Some((w, _)) = votes.iter().max_by_key(|(_, k)| *k) {
+                (*w).clone()
+            } else {
+                return true;
+            };
+            for &a in &owner[&m] {
+                travel.insert(a, way.clone());
+            }
+            false
+        });
+        if pending.len() == before {
+            break;
         }
-        movers.push(m);
     }
+    for &(m, d) in &pending {
+        for &a in &owner[&m] {
+            travel.insert(a, lead_way(d));
+        }
+    }
+    movers.extend(carried.iter().map(|&(m, _)| m));
     if len == 0 {
         return steps;
     }
@@ -909,22 +1060,21 @@ fn expand_tracked(
                     .map(|st| st.iter().map(event).collect())
                     .collect()
             };
-            // The slider's atoms (the scene's third meta-module, slice
-            // atoms 8–11), where they are after each step of the run.
+            // The slider's atoms (the scene's third meta-module), where
+            // they are after each step of the run.
             let last = lib.track.len() - 1;
-            let motion = (8..12)
-                .flat_map(|a2| (0..2).map(move |h| (a2, h)))
-                .map(|(a2, h)| {
+            let motion = SLIDER
+                .map(|q| {
                     let offsets = (0..=last)
                         .map(|t| {
                             turn.apply(if back {
-                                lib.track[last - t][a2] - lib.track[last][a2]
+                                lib.track[last - t][q] - lib.track[last][q]
                             } else {
-                                lib.track[t][a2] - lib.track[0][a2]
+                                lib.track[t][q] - lib.track[0][q]
                             })
                         })
                         .collect();
-                    (atom(2 * a2 + h), offsets)
+                    (atom(q), offsets)
                 })
                 .collect();
             slides.push(Plan {
@@ -1199,6 +1349,33 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_expanded_slide_between_two_walls_replays_one_layer_at_a_time() {
+        let lib = double_slide_library(AtomRest::Expanded).expect("replays to the goal");
+        assert_eq!(lib.steps.len(), 24);
+        let ops: usize = lib.steps.iter().map(Vec::len).sum();
+        assert_eq!(ops, 2 * 48 + 16);
+        // The top layer (odd atoms) moves in the first 12 steps only, the
+        // bottom layer in the last 12 only.
+        let moves = |q: usize, t: usize| lib.track[t + 1][q] != lib.track[t][q];
+        for q in SLIDER {
+            let (first, second) = if q % 2 == 1 {
+                (0..12, 12..24)
+            } else {
+                (12..24, 0..12)
+            };
+            assert!(first.clone().any(|t| moves(q, t)), "atom {q}");
+            assert!(!second.clone().any(|t| moves(q, t)), "atom {q}");
+        }
+        // Loads behind start with the bottom layer.
+        assert_eq!(lib.carrier_step(), Some(12 + 5));
+        // Without its last step it does not end at the goal: refused.
+        let (_, single) = super::super::stored_move::expanded_slide(Carry::None).unwrap();
+        let mut cut = single.clone();
+        cut.steps.pop();
+        assert!(layered_double_slide(cut).is_none());
     }
 
     #[test]
