@@ -388,6 +388,32 @@ fn combing_random_polyominoes_in_the_expanded_model_certifies_atom_by_atom_in_pl
 }
 
 #[test]
+fn the_bundled_expanded_model_scenarios_run_and_certify_from_the_command_line() {
+    // Both need a SLIDE between two walls (seed 1 in 2D, seed 2 in 3D).
+    for name in ["comb-2d-expanded.toml", "comb-3d-expanded.toml"] {
+        let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios")
+            .join(name);
+        let o = common::bin()
+            .args(["run", "--no-progress"])
+            .arg(&scenario)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{name}: {text}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            text.contains("CERTIFIED") && text.contains("in place"),
+            "{name}: {text}"
+        );
+    }
+}
+
+#[test]
 fn combing_random_polyominoes_certifies_atom_by_atom_in_place() {
     for rest in [AtomRest::Contracted] {
         for seed in 0..6 {
