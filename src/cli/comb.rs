@@ -6,7 +6,7 @@
 
 use reconfcheck::algorithms::atom_moves::derive_slide;
 use reconfcheck::error::{Error, write_file};
-use reconfcheck::geometry::atom_expand::tunnel_library;
+use reconfcheck::geometry::atom_expand::{double_slide_library, tunnel_library};
 use reconfcheck::geometry::atom_search::{Carry, Legs};
 use reconfcheck::lattice::AtomRest;
 use reconfcheck::study::comb as study;
@@ -62,6 +62,21 @@ pub fn run(a: Args) -> Result<u8, Error> {
                 ),
                 None => println!("{:<11} {:<18} not found", format!("{rest:?}"), carry.name()),
             }
+        }
+    }
+    for rest in [AtomRest::Contracted, AtomRest::Expanded] {
+        let how = match rest {
+            AtomRest::Contracted => "searched",
+            AtomRest::Expanded => "the stored SLIDE one layer at a time",
+        };
+        match double_slide_library(rest) {
+            Some(l) => println!(
+                "SLIDE between two walls, {} ({how}; paper: O(1)): {} steps, {} ops",
+                format!("{rest:?}").to_lowercase(),
+                l.steps.len(),
+                l.steps.iter().map(Vec::len).sum::<usize>()
+            ),
+            None => println!("SLIDE between two walls, {rest:?}: not found"),
         }
     }
     for legs in Legs::ALL {

@@ -5,8 +5,10 @@
 //! * `slide` with a `pivot` (the wall B; C is the meta-module beside B in
 //!   the slide direction): the SLIDE that [`crate::geometry::atom_search`]
 //!   derives (the expanded model's stored by
-//!   [`crate::geometry::stored_move`] and replayed on load), turned to the move's direction and wall by the lattice
-//!   symmetry that maps the canonical slide (−x along a wall at −y) onto it.
+//!   [`crate::geometry::stored_move`] and replayed on load; between two
+//!   walls, in the expanded model, that SLIDE run one layer at a time),
+//!   turned to the move's direction and wall by the lattice symmetry that
+//!   maps the canonical slide (−x along a wall at −y) onto it.
 //!   Every slide of one meta-level step runs in lockstep, shifted so that
 //!   the steps in which their carried meta-modules move coincide. A wall
 //!   across the slide's lift (3D: walls on two perpendicular sides) is
