@@ -241,18 +241,12 @@ fn a_theorem_1_scenario_is_refused_at_atom_level_naming_the_tunnel_and_certified
         err.contains("t1.json") && err.contains("1-TUNNEL") && err.contains("turns 2 times"),
         "{err}"
     );
-    let o = common::bin()
-        .args(["certify", "--meta-level", "--no-progress"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{text}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = common::stdout_of_success([
+        std::ffi::OsStr::new("certify"),
+        "--meta-level".as_ref(),
+        "--no-progress".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(
         text.contains("CERTIFIED") && text.contains("NOT certified"),
         "{text}"

@@ -58,6 +58,24 @@ pub fn bin() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
 }
 
+/// Runs the binary with `args`, asserts exit 0 (showing both streams if
+/// not) and returns its standard output.
+pub fn stdout_of_success<I, S>(args: I) -> String
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let o = bin().args(args).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    text
+}
+
 /// A path `name` in a scratch folder of this test process (`tag` keeps
 /// test files apart).
 pub fn scratch(tag: &str, name: &str) -> std::path::PathBuf {

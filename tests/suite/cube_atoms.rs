@@ -394,18 +394,11 @@ fn the_bundled_expanded_model_scenarios_run_and_certify_from_the_command_line() 
         let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenarios")
             .join(name);
-        let o = common::bin()
-            .args(["run", "--no-progress"])
-            .arg(&scenario)
-            .output()
-            .unwrap();
-        let text = String::from_utf8_lossy(&o.stdout);
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{name}: {text}{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        let text = common::stdout_of_success([
+            std::ffi::OsStr::new("run"),
+            "--no-progress".as_ref(),
+            scenario.as_os_str(),
+        ]);
         assert!(
             text.contains("CERTIFIED") && text.contains("in place"),
             "{name}: {text}"
@@ -729,6 +722,31 @@ fn comb3_schedule(m: usize, seed: u64, rest: AtomRest) -> Schedule {
     schedule_of(&shape, r.steps, rest)
 }
 
+/// Certifies the 3D combing of each (meta-modules, seed) polycube atom by
+/// atom in place, with the mechanics (some arm must carry a load);
+/// returns how many sliders had walls on two perpendicular sides.
+fn certify_3d_combings(cases: &[(usize, u64)], rest: AtomRest) -> usize {
+    let mut perpendicular = 0;
+    for &(m, seed) in cases {
+        let s = comb3_schedule(m, seed, rest);
+        perpendicular += perpendicular_walls(&s);
+        let r = run(&s);
+        assert!(
+            r.certified,
+            "{rest:?}, {m} meta-modules, seed {seed}:\n{}",
+            r.summary()
+        );
+        assert!(r.checks.iter().any(|c| c.contains("in place")));
+        assert_eq!(r.per_step.len(), r.steps);
+        assert!(
+            r.per_step
+                .iter()
+                .any(|st| st.metrics["max_utilisation"] > 0.0)
+        );
+    }
+    perpendicular
+}
+
 /// Sliders with walls on two perpendicular sides, over the schedule.
 fn perpendicular_walls(s: &Schedule) -> usize {
     let mut n = 0;
@@ -757,18 +775,10 @@ fn combing_random_polycubes_in_3d_in_the_expanded_model_certifies_atom_by_atom()
     // wall it faced when it stopped (B, then B's or C's other row, then C),
     // (8, 5), (8, 8) and (24, 5) were rejected by the certifier (three
     // meta-modules disconnected mid-slide).
-    let mut perpendicular = 0;
-    for (m, seed) in [(8, 5), (8, 8), (24, 1), (24, 4), (24, 5), (24, 6)] {
-        let s = comb3_schedule(m, seed, AtomRest::Expanded);
-        let r = run(&s);
-        assert!(
-            r.certified,
-            "{m} meta-modules, seed {seed}:\n{}",
-            r.summary()
-        );
-        assert!(r.checks.iter().any(|c| c.contains("in place")));
-        perpendicular += perpendicular_walls(&s);
-    }
+    let perpendicular = certify_3d_combings(
+        &[(8, 5), (8, 8), (24, 1), (24, 4), (24, 5), (24, 6)],
+        AtomRest::Expanded,
+    );
     assert!(perpendicular > 0, "no slider with two walls was exercised");
 }
 
@@ -778,24 +788,10 @@ fn combing_random_polycubes_in_3d_certifies_atom_by_atom_in_place() {
     // slider's slice, across its lift (attached to all four of the
     // slider's atoms on that face: an arm conflict before); the others
     // have sliders with walls on two perpendicular sides (refused before).
-    let mut perpendicular = 0;
-    for (m, seed) in [(8, 5), (8, 8), (24, 1), (24, 4), (24, 5)] {
-        let s = comb3_schedule(m, seed, AtomRest::Contracted);
-        perpendicular += perpendicular_walls(&s);
-        let r = run(&s);
-        assert!(
-            r.certified,
-            "{m} meta-modules, seed {seed}:\n{}",
-            r.summary()
-        );
-        assert!(r.checks.iter().any(|c| c.contains("in place")));
-        assert_eq!(r.per_step.len(), r.steps);
-        assert!(
-            r.per_step
-                .iter()
-                .any(|st| st.metrics["max_utilisation"] > 0.0)
-        );
-    }
+    let perpendicular = certify_3d_combings(
+        &[(8, 5), (8, 8), (24, 1), (24, 4), (24, 5)],
+        AtomRest::Contracted,
+    );
     assert!(perpendicular > 0, "no slider with two walls was exercised");
 }
 
