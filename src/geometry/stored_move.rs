@@ -251,6 +251,17 @@ mod tests {
         assert!(expanded_slide(Carry::Above).is_err());
     }
 
+    /// The search run again finds exactly the stored sequence (about a
+    /// minute in release, several in a test build: run it with
+    /// `cargo test --release -- --ignored the_stored_expanded_slide_is`;
+    /// `reconfcheck derive-moves --check` does the same).
+    #[test]
+    #[ignore = "a minute-long search; reconfcheck derive-moves --check runs it too"]
+    fn the_stored_expanded_slide_is_what_the_search_finds() {
+        let stored = StoredMove::parse(EXPANDED_SLIDE_TEXT, EXPANDED_SLIDE_FILE).unwrap();
+        assert_eq!(derive_expanded_slide(), Some(stored));
+    }
+
     /// Each kind of damage to the stored sequence is refused, naming the step.
     #[test]
     fn a_damaged_stored_sequence_is_refused_naming_its_step() {
