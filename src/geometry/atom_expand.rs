@@ -109,21 +109,27 @@ impl SlideLibrary {
         }
     }
 
-    /// Replays lifted `steps` from `start` (frame: `anchors`), recording
-    /// every atom's track; `None` if a step is invalid or the end is not
-    /// `goal` (when given).
+    /// Replays lifted `steps` from `start` (the lift of `slice`'s start;
+    /// frame: the lift of its anchors, tolerance its own), recording every
+    /// atom's track; `None` if a step is invalid or the end is not `goal`
+    /// (when given).
     fn replayed(
         found: Found,
         start: &Scene,
         goal: Option<&Scene>,
         steps: Vec<Vec<Op>>,
-        anchors: &[usize],
+        slice: &Problem,
         carried: Vec<usize>,
     ) -> Option<SlideLibrary> {
+        let anchors: Vec<usize> = slice
+            .anchors
+            .iter()
+            .flat_map(|&a| [2 * a, 2 * a + 1])
+            .collect();
         let mut scene = start.clone();
         let mut track = vec![scene.pos.clone()];
         for st in &steps {
-            scene = scene.step(st, anchors, 1e-6)?;
+            scene = scene.step(st, &anchors, slice.eps)?;
             track.push(scene.pos.clone());
         }
         if goal.is_some_and(|g| *g != scene) {
@@ -205,9 +211,8 @@ pub fn layered_double_slide(single: Found) -> Option<SlideLibrary> {
         }
         steps.extend(run);
     }
-    let anchors: Vec<usize> = p.anchors.iter().flat_map(|&a| [2 * a, 2 * a + 1]).collect();
     // Loads behind follow the bottom layer's trailing atom (slice atom 9).
-    SlideLibrary::replayed(single, &start, Some(&goal), steps, &anchors, vec![2 * 9])
+    SlideLibrary::replayed(single, &start, Some(&goal), steps, &p, vec![2 * 9])
 }
 
 /// The SLIDE of `rest`: the contracted model's searched once per process;
@@ -250,13 +255,8 @@ fn library(
     cell.get_or_init(|| {
         let (problem, carried, found) = make()?;
         let (start, steps) = lift(&problem.start, &found.steps, rest_spacing(rest));
-        let anchors: Vec<usize> = problem
-            .anchors
-            .iter()
-            .flat_map(|&a| [2 * a, 2 * a + 1])
-            .collect();
         let carried = carried.iter().map(|&a| 2 * a).collect();
-        SlideLibrary::replayed(found, &start, None, steps, &anchors, carried)
+        SlideLibrary::replayed(found, &start, None, steps, &problem, carried)
     })
     .as_ref()
 }
@@ -413,16 +413,6 @@ fn face_pairs(ca: Cell, cb: Cell) -> Option<Vec<(usize, usize)>> {
     )
 }
 
-/// The six neighbouring cells' offsets.
-const SIX: [Cell; 6] = [
-    Cell::new(1, 0, 0),
-    Cell::new(-1, 0, 0),
-    Cell::new(0, 1, 0),
-    Cell::new(0, -1, 0),
-    Cell::new(0, 0, 1),
-    Cell::new(0, 0, -1),
-];
-
 fn pair_of(a: ModuleId, b: ModuleId) -> (ModuleId, ModuleId) {
     if a < b { (a, b) } else { (b, a) }
 }
@@ -541,7 +531,10 @@ fn in_lockstep(
                     })
             };
             let mut votes: Vec<(&Vec<Cell>, usize)> = Vec::new();
-            for n in SIX.iter().filter_map(|&s| by_cell.get(&(at[&m] + s))) {
+            for n in Face::ALL
+                .iter()
+                .filter_map(|f| by_cell.get(&(at[&m] + f.dir())))
+            {
                 for (la, lb) in face_pairs(at[&m], at[n]).expect("neighbours") {
                     let (a, b) = (owner[&m][la], owner[n][lb]);
                     let Some(w) = travel.get(&b).filter(|w| straight(w)) else {
@@ -637,10 +630,10 @@ fn in_lockstep(
                 let Some(way) = travel.get(&a) else { continue };
                 let start = atoms_of(m, at[&m], sp).nth(la).expect("eight atoms").cell;
                 // A slider the schedule let go of this wall is left alone.
-                let mut held = Some(owner[&b][lb]);
                 if !bonds.contains(&pair_of(a, owner[&b][lb])) {
                     continue;
                 }
+                let mut held = Some(owner[&b][lb]);
                 for t in 0..len {
                     if way[t + 1] == way[t] {
                         continue;
@@ -1174,6 +1167,15 @@ mod tests {
         }
     }
 
+    /// A meta-module of a test schedule.
+    fn meta(id: ModuleId, c: [i32; 3], fixed: bool) -> ModuleSpec {
+        ModuleSpec {
+            id,
+            cell: Cell::new(c[0], c[1], c[2]),
+            fixed,
+        }
+    }
+
     /// Replays an atom schedule's events with the search's step rules.
     fn replay(atoms: &Schedule) -> FxHashMap<ModuleId, Cell> {
         let ids: Vec<ModuleId> = atoms.modules.iter().map(|m| m.id).collect();
@@ -1211,11 +1213,7 @@ mod tests {
         // through B to the exit (1, 0, 0), turned so that the slice is
         // lifted along y. Then the same with long legs: an in-leg of three
         // (A, D, D2 the leaf) and an out-leg E, E2 before the exit.
-        let m = |id: ModuleId, c: [i32; 3]| ModuleSpec {
-            id,
-            cell: Cell::new(c[0], c[1], c[2]),
-            fixed: id == 0,
-        };
+        let m = |id: ModuleId, c: [i32; 3]| meta(id, c, id == 0);
         let cells = |p: &[[i32; 3]]| {
             p.iter()
                 .map(|c| Cell::new(c[0], c[1], c[2]))
@@ -1290,11 +1288,7 @@ mod tests {
         // E (5) on it; then the same slide run backwards: A pushes P (6)
         // ahead of it instead (P lets go of C before and holds the row's
         // end after: the schedule's latches).
-        let m = |id: ModuleId, c: [i32; 3]| ModuleSpec {
-            id,
-            cell: Cell::new(c[0], c[1], c[2]),
-            fixed: id == 2,
-        };
+        let m = |id: ModuleId, c: [i32; 3]| meta(id, c, id == 2);
         let slide =
             |id: ModuleId, from: [i32; 3], to: [i32; 3], pivot: Option<ModuleId>| Event::Slide {
                 module: id,

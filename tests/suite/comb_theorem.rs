@@ -241,12 +241,11 @@ fn a_theorem_1_scenario_is_refused_at_atom_level_naming_the_tunnel_and_certified
         err.contains("t1.json") && err.contains("1-TUNNEL") && err.contains("turns 2 times"),
         "{err}"
     );
-    let text = common::stdout_of_success([
-        std::ffi::OsStr::new("certify"),
-        "--meta-level".as_ref(),
-        "--no-progress".as_ref(),
-        out.as_os_str(),
-    ]);
+    let text = common::succeeds(
+        common::bin()
+            .args(["certify", "--meta-level", "--no-progress"])
+            .arg(&out),
+    );
     assert!(
         text.contains("CERTIFIED") && text.contains("NOT certified"),
         "{text}"

@@ -58,22 +58,18 @@ pub fn bin() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_reconfcheck"))
 }
 
-/// Runs the binary with `args`, asserts exit 0 (showing both streams if
-/// not) and returns its standard output.
-pub fn stdout_of_success<I, S>(args: I) -> String
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<std::ffi::OsStr>,
-{
-    let o = bin().args(args).output().unwrap();
-    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+/// Runs `cmd`, asserts exit 0 (showing both outputs otherwise) and
+/// returns its standard output.
+pub fn succeeds(cmd: &mut std::process::Command) -> String {
+    let o = cmd.output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert_eq!(
         o.status.code(),
         Some(0),
-        "{text}{}",
+        "{out}{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    text
+    out
 }
 
 /// A path `name` in a scratch folder of this test process (`tag` keeps

@@ -394,11 +394,7 @@ fn the_bundled_expanded_model_scenarios_run_and_certify_from_the_command_line() 
         let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenarios")
             .join(name);
-        let text = common::stdout_of_success([
-            std::ffi::OsStr::new("run"),
-            "--no-progress".as_ref(),
-            scenario.as_os_str(),
-        ]);
+        let text = common::succeeds(common::bin().args(["run", "--no-progress"]).arg(&scenario));
         assert!(
             text.contains("CERTIFIED") && text.contains("in place"),
             "{name}: {text}"

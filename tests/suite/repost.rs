@@ -344,20 +344,6 @@ fn a_follower_catom_sets_off_before_its_leader_arrives_and_the_pipeline_certifie
     assert!(r.certified, "{}", r.summary());
 }
 
-/// Runs `cmd`, asserts exit 0 (showing both outputs otherwise) and
-/// returns its standard output.
-fn succeeds(cmd: &mut std::process::Command) -> String {
-    let o = cmd.output().unwrap();
-    let out = String::from_utf8_lossy(&o.stdout).into_owned();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    out
-}
-
 /// `repost-study` on a three-meta-module line whose end climbs onto the
 /// middle: the iteration table (with the paper's peak, 10 × streamlines),
 /// Fig. 9 drawn as a PNG, and the JSON curves, whose rotations add up to
@@ -378,7 +364,7 @@ fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
         common::scratch(tag, "f9.png"),
         common::scratch(tag, "f9.json"),
     );
-    let out = succeeds(
+    let out = common::succeeds(
         common::bin()
             .arg("repost-study")
             .arg(&sc)
@@ -424,7 +410,7 @@ fn repost_study_tabulates_and_draws_fig9_and_refuses_other_generators() {
 fn repost_study_fig10_plans_each_size_and_fits_time_against_diameter() {
     let root = env!("CARGO_MANIFEST_DIR");
     let json = common::scratch("repost-fig10", "f10.json");
-    let out = succeeds(
+    let out = common::succeeds(
         common::bin()
             .args([
                 "repost-study",
