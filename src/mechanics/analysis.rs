@@ -940,12 +940,24 @@ impl Analyzer {
             let u = severity(utilisation(&load, cap).0);
             j_out.worst = j_out.worst.max(u);
             // A witness must also be carried by the limit analysis's
-            // corner forces (torsion on a square pressed off-centre).
-            let r = if u > CORNER_FREE_BELOW {
+            // corner forces (torsion on a square pressed off-centre). The
+            // closed-form construction is one distribution among many:
+            // where it fails within the utilisation, the link alone is
+            // asked whether any distribution carries it (a few SOCP
+            // variables against a limit analysis of the whole component).
+            let mut r = if u > CORNER_FREE_BELOW {
                 severity(corner_ratio(&load, cap))
             } else {
                 0.0
             };
+            if self.settings.corner_gate && overloaded(r) && !overloaded(u) {
+                let f = sf(li);
+                let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
+                let carried = limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1);
+                if carried >= 1.0 {
+                    r = 1.0 / carried;
+                }
+            }
             if self.settings.corner_gate && overloaded(r) {
                 j_out.gate = j_out.gate.max(r);
                 // First scale by `k₀ = max(u, 1)`, which brings the load

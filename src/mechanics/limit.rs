@@ -120,6 +120,55 @@ pub fn load_factor_with_field(
     solve(s, model, loads, part, which, true)
 }
 
+/// The largest multiple of the action of side `a` on side `b` through
+/// link `li` alone — the force `force` and the moment `moment` about the
+/// contact, in `W` and `W·d` — that the link's corners carry, proved as
+/// [`load_factor`]'s is: the rows are the limit analysis's own
+/// ([`capacity_rows`]) and six equations balance the corners against the
+/// action. At least 1: one admissible corner distribution of that
+/// resultant exists, so an equilibrium of the whole structure whose every
+/// link passes carries its loads (lower-bound theorem). The elastic screen
+/// asks this where the closed-form corner construction
+/// ([`super::capacity::corner_ratio`], one distribution among many) does
+/// not carry a link; NaN input gives NaN, read as overloaded.
+pub fn link_load_factor(
+    s: &Structure,
+    model: &Model,
+    li: usize,
+    force: glam::DVec3,
+    moment: glam::DVec3,
+) -> f64 {
+    let l = &s.links[li];
+    let mut prog = Program::new(6, PER_LINK);
+    let half = 0.5 * capacity(s, model, li).side / model.spacing;
+    for (ki, (su, sv)) in CORNERS.iter().enumerate() {
+        let arm = half * (su * l.u + sv * l.v);
+        // Unit forces on side b: a tension n pulls b towards a.
+        for (j, f) in [-l.normal, l.u, l.v].iter().enumerate() {
+            let m = arm.cross(*f);
+            for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
+                prog.push(a, PER_CORNER * ki + j, v);
+            }
+        }
+    }
+    let action = [force.x, force.y, force.z, moment.x, moment.y, moment.z];
+    if action.iter().any(|v| !v.is_finite()) {
+        return f64::NAN;
+    }
+    for (a, v) in action.into_iter().enumerate() {
+        prog.push(a, prog.lam, -v);
+    }
+    capacity_rows(&mut prog, s, model, &[li]);
+    let to_prove = prog.clone();
+    proof::reserve_pressure(&mut prog);
+    let (r, x) = maximise(prog);
+    if r.lambda.is_nan() {
+        return f64::NAN;
+    }
+    x.and_then(|x| proof::prove(&to_prove, &x, r.lambda))
+        .map_or(0.0, |p| p.lambda)
+}
+
 /// Where each free body's six equations start (`usize::MAX` for the
 /// others), and how many groups of six there are. With capacities, every
 /// free body of the part is balanced on its own (moments about its
@@ -809,6 +858,138 @@ mod tests {
         // The proof's factor from the first try is at least the one the
         // retry proved (a lower bound either way: the larger is closer).
         assert!(r.lambda >= 11.6134 && r.lambda < 11.7, "{r:?}");
+    }
+
+    /// A fixed module at `(0, 0, 1)` and its neighbour in direction
+    /// `dir`: one link, in each of the lattice's twelve frames.
+    fn pair(dir: usize) -> Structure {
+        use crate::lattice::Lattice;
+        let centre = Cell::new(0, 0, 1);
+        let cells = [centre, FccLattice.neighbour(centre, dir)];
+        structure(&FccLattice, None, &cells, &[0], &[])
+    }
+
+    /// The action on side b (force, moment about the contact; `W`, `W·d`)
+    /// of corner forces `(n, t_u, t_v)`, tension positive, summed here
+    /// from the square's geometry.
+    fn resultant(
+        l: &crate::mechanics::structure::Link,
+        half: f64,
+        corners: &[[f64; 3]; 4],
+    ) -> (DVec3, DVec3) {
+        let (mut f, mut m) = (DVec3::ZERO, DVec3::ZERO);
+        for ((su, sv), [n, tu, tv]) in CORNERS.iter().zip(corners) {
+            let arm = half * (su * l.u + sv * l.v);
+            let fk = -*n * l.normal + *tu * l.u + *tv * l.v;
+            f += fk;
+            m += arm.cross(fk);
+        }
+        (f, m)
+    }
+
+    #[test]
+    fn a_link_carries_what_admissible_corner_forces_add_up_to() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for bending in [Bending::RigidHinge, Bending::Elastic] {
+            let mut model = Model::default_catom();
+            model.connector.bending = bending;
+            let p = model.connector.tension() / model.weight() / 4.0;
+            let (mu, half) = (
+                model.connector.friction,
+                0.5 * model.connector.side / model.spacing,
+            );
+            let mut tried = 0;
+            for dir in 0..12 {
+                let s = pair(dir);
+                let l = &s.links[0];
+                while tried < 30 * (dir + 1) {
+                    // Each corner pulls at most 90 % of its share, pushes
+                    // up to three shares, and rubs within 90 % of its cone.
+                    let corners: [[f64; 3]; 4] = std::array::from_fn(|_| {
+                        let n = p * rng.random_range(-3.0..0.9);
+                        let (r, a) = (
+                            rng.random_range(0.0..0.9),
+                            rng.random_range(0.0..std::f64::consts::TAU),
+                        );
+                        let t = r * mu * (p - n);
+                        [n, t * a.cos(), t * a.sin()]
+                    });
+                    if bending == Bending::Elastic {
+                        // The linear stress distribution's rows, with 10 % spare.
+                        let ok = CORNERS.iter().all(|(eu, ev)| {
+                            let lhs: f64 = CORNERS
+                                .iter()
+                                .zip(&corners)
+                                .map(|((su, sv), c)| c[0] * (1.0 + 3.0 * (eu * su + ev * sv)))
+                                .sum();
+                            lhs <= 0.9 * 4.0 * p
+                        });
+                        if !ok {
+                            continue;
+                        }
+                    }
+                    tried += 1;
+                    let (f, m) = resultant(l, half, &corners);
+                    let lam = link_load_factor(&s, &model, 0, f, m);
+                    assert!(
+                        lam >= 1.0,
+                        "{bending:?}, direction {dir}: {corners:?} carried {lam} times"
+                    );
+                    // The same forces mirrored across the square's u axis.
+                    let mirrored: [[f64; 3]; 4] = [corners[1], corners[0], corners[3], corners[2]]
+                        .map(|[n, tu, tv]| [n, tu, -tv]);
+                    let (f, m) = resultant(l, half, &mirrored);
+                    assert!(link_load_factor(&s, &model, 0, f, m) >= 1.0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_link_refuses_what_no_corner_forces_can_carry() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        let model = Model::default_catom();
+        let p4 = model.connector.tension() / model.weight();
+        let (mu, half) = (
+            model.connector.friction,
+            0.5 * model.connector.side / model.spacing,
+        );
+        let mut refused = 0;
+        for dir in 0..12 {
+            let s = pair(dir);
+            let l = &s.links[0];
+            for _ in 0..60 {
+                let mut v = |k: f64| {
+                    DVec3::new(
+                        rng.random_range(-k..k),
+                        rng.random_range(-k..k),
+                        rng.random_range(-k..k),
+                    )
+                };
+                let (f, m) = (v(2.0 * p4), v(2.0 * p4 * half));
+                let lam = link_load_factor(&s, &model, 0, f, m);
+                // Necessary for any corner forces: the tension within the
+                // adhesion, the shear within the friction of the clamp, the
+                // torsion within that friction at the corners' distance.
+                let tension = -f.dot(l.normal);
+                let clamp = p4 - tension;
+                let shear = (f + tension * l.normal).length();
+                let torsion = m.dot(l.normal).abs();
+                let possible = clamp >= 0.0
+                    && shear <= mu * clamp
+                    && torsion <= mu * clamp * half * std::f64::consts::SQRT_2;
+                if !possible {
+                    refused += 1;
+                    assert!(lam < 1.0, "direction {dir}: {f} {m} carried {lam} times");
+                }
+            }
+        }
+        assert!(refused > 300, "{refused}");
+        // NaN in, NaN out: never a factor that reads as carried.
+        let nan = link_load_factor(&pair(0), &model, 0, DVec3::NAN, DVec3::ZERO);
+        assert!(nan.is_nan(), "{nan}");
     }
 
     #[test]
