@@ -192,6 +192,9 @@ struct LimitOutcome {
     /// A proven lower bound of the smallest factor over the poses (see
     /// [`Analysis::load_factor_lower`]).
     lower: f64,
+    /// The solver setting the first limit analysis needed
+    /// ([`Analyzer::limit_setting`]).
+    setting: usize,
 }
 
 /// Solver settings.
@@ -440,9 +443,23 @@ pub struct Analyzer {
     references: Vec<Reference>,
     owner: FxHashMap<BodyKey, u32>,
     blocks: FxHashMap<([u64; 3], bool, bool), Arc<LinkBlocks>>,
+    /// Where limit analyses start in `limit::SETTINGS`: the setting that
+    /// solved the latest first pose of a failing component. A component
+    /// whose structure stalls at clarabel's own regularisation (the
+    /// sandcastle's) pays that try once, not at every pose of every step;
+    /// one solved there (the RePoSt structures) never leaves it. Set only
+    /// by the first pose of each analysis, which is solved alone, in an
+    /// order fixed by the schedule: reports do not depend on threads.
+    limit_setting: usize,
 }
 
 impl Analyzer {
+    /// Where the next limit analysis starts in `limit::SETTINGS`
+    /// ([`Analyzer::limit_setting`]'s field).
+    pub fn limit_setting(&self) -> usize {
+        self.limit_setting
+    }
+
     pub fn new(model: Model, incremental: bool) -> Analyzer {
         let springs = Springs::new(&model, &model.connector);
         let ground_springs = Springs::new(&model, &model.ground);
@@ -456,6 +473,7 @@ impl Analyzer {
             references: Vec::new(),
             owner: FxHashMap::default(),
             blocks: FxHashMap::default(),
+            limit_setting: 0,
         }
     }
 
@@ -579,6 +597,7 @@ impl Analyzer {
             out.sampled_only += usize::from(screen.sampled_only);
             if !screen.failing.is_empty() {
                 let mut limit = self.limit(s, &comps, c, &screen.failing);
+                self.limit_setting = limit.setting;
                 limit.admissible = screen.admissible;
                 out.limit_analyses += limit.runs;
                 if limit.rigid < 1.0 || limit.rigid.is_nan() {
@@ -1088,6 +1107,7 @@ impl Analyzer {
             runs: 0,
             partial: false,
             lower: f64::INFINITY,
+            setting: self.limit_setting,
         };
         let part = limit::Part {
             bodies: &comps.bodies[c],
@@ -1103,6 +1123,9 @@ impl Analyzer {
         let tolerance = self.settings.load_factor_tolerance;
         let mut fields: Vec<(Option<usize>, limit::Field)> = Vec::new();
         let mut wave = 1;
+        // The setting the first solve needed starts the others
+        // (`limit::load_factor_from`): the first wave is that one pose.
+        let (mut start, mut first_wave) = (self.limit_setting, true);
         let mut failed = false;
         for (i, &(pose, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
@@ -1153,12 +1176,22 @@ impl Analyzer {
                         let (model, c) = (&self.model, Connectors::Capacities);
                         // Equilibria are kept only to bound later poses.
                         if tolerance > 0.0 {
-                            limit::load_factor_with_field(s, model, &loads, part, c)
+                            limit::load_factor_with_field(s, model, &loads, part, c, start)
                         } else {
-                            (limit::load_factor(s, model, &loads, part, c), None)
+                            (
+                                limit::load_factor_from(s, model, &loads, part, c, start),
+                                None,
+                            )
                         }
                     })
                     .collect();
+                if first_wave {
+                    let setting = results[0].0.setting;
+                    if setting < limit::SETTINGS.len() {
+                        start = setting;
+                    }
+                    first_wave = false;
+                }
                 for (&j, r) in ahead.iter().zip(results) {
                     solved[j] = Some(r);
                 }
@@ -1175,6 +1208,7 @@ impl Analyzer {
             out.lower = lowest(out.lower, cap.lambda);
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
+        out.setting = start;
         // With rigid connectors the feasible forces include every one
         // within capacities (the support rows are the same, and summing
         // the bodies' balances cancels the internal links), so the rigid

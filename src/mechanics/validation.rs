@@ -52,6 +52,25 @@ pub(crate) fn structure_without(
 
 /// The cells of an `nx × ny × nz` block of FCC cells, layer by layer
 /// (the first `nx·ny` are the bottom layer).
+/// A scaffold-like frame of `a × a × h` cubic tiles of side 6 (the
+/// cells on the tiles' edges), fixed at its bottom layer.
+pub(crate) fn frame(a: i32, h: i32) -> Structure {
+    let b = 6;
+    let mut cells = Vec::new();
+    for x in 0..=a * b {
+        for y in 0..=a * b {
+            for z in 0..=h * b {
+                let edges = [x % b, y % b, z % b].iter().filter(|&&r| r == 0).count();
+                if edges >= 2 {
+                    cells.push(Cell::new(x, y, z));
+                }
+            }
+        }
+    }
+    let fixed: Vec<usize> = (0..cells.len()).filter(|&i| cells[i].z == 0).collect();
+    structure(&FccLattice, None, &cells, &fixed, &[])
+}
+
 fn block(nx: i32, ny: i32, nz: i32) -> Vec<Cell> {
     (0..nz)
         .flat_map(|z| (0..nx).flat_map(move |x| (0..ny).map(move |y| Cell::new(x, y, z))))
@@ -683,4 +702,25 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
             assert_eq!(e.load_factor.map(f64::to_bits), Some(lambda.to_bits()));
         }
     }
+}
+
+#[test]
+fn a_limit_analysis_starts_where_the_last_first_pose_was_solved_and_gives_the_same_factor() {
+    // A frame at an eighth of the adhesion, judged by the limit analysis
+    // (λ = 1.35; the 2 × 2 frame is solved at 1e-8), which stalls at clarabel's own
+    // regularisation (limit::SETTINGS) and is solved at the next setting.
+    let mut model = Model::default_catom();
+    model.connector.pressure /= 8.0;
+    let s = frame(3, 2);
+    let mut analyzer = Analyzer::new(model.clone(), false);
+    assert_eq!(analyzer.limit_setting(), 0);
+    let first = analyzer.analyse(&s);
+    assert!(first.limit_analyses >= 1, "{}", first.limit_analyses);
+    assert_eq!(analyzer.limit_setting(), 1);
+    // The next analysis starts there: one try instead of two, and the
+    // same solve, so the same factor to the bit.
+    let again = analyzer.analyse(&s);
+    assert_eq!(again.load_factor, first.load_factor);
+    assert!(first.load_factor.unwrap() > 1.0, "{:?}", first.load_factor);
+    assert_eq!(analyzer.limit_setting(), 1);
 }
