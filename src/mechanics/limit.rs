@@ -773,6 +773,11 @@ mod tests {
     use crate::mechanics::validation::{frame, structure};
     use glam::DVec3;
 
+    /// Every body and every link of `s`: the part that is the whole.
+    fn everything(s: &Structure) -> (Vec<usize>, Vec<usize>) {
+        ((0..s.bodies.len()).collect(), (0..s.links.len()).collect())
+    }
+
     /// Gravity on every body (units of `W`), as the analyser loads them.
     fn gravity(s: &Structure) -> Vec<Vec6> {
         let g = s.gravity;
@@ -789,8 +794,7 @@ mod tests {
     /// in many directions and sizes, against the limit analysis of the
     /// changed loads itself: never above it, and not trivially low.
     fn check_bounds(s: &Structure, model: &Model) -> usize {
-        let bodies: Vec<usize> = (0..s.bodies.len()).collect();
-        let links: Vec<usize> = (0..s.links.len()).collect();
+        let (bodies, links) = everything(&s);
         let part = Part {
             bodies: &bodies,
             links: &links,
@@ -863,8 +867,7 @@ mod tests {
         // setting its first pose needed: one try, the same factor.
         let model = Model::default_catom();
         let s = frame(2, 2);
-        let bodies: Vec<usize> = (0..s.bodies.len()).collect();
-        let links: Vec<usize> = (0..s.links.len()).collect();
+        let (bodies, links) = everything(&s);
         let part = Part {
             bodies: &bodies,
             links: &links,
@@ -1025,8 +1028,7 @@ mod tests {
         let model = Model::default_catom();
         let cells: Vec<Cell> = (0..=3).map(|i| Cell::new(i, 0, 0)).collect();
         let s = structure(&FccLattice, None, &cells, &[0], &[]);
-        let bodies: Vec<usize> = (0..s.bodies.len()).collect();
-        let links: Vec<usize> = (0..s.links.len()).collect();
+        let (bodies, links) = everything(&s);
         let part = Part {
             bodies: &bodies,
             links: &links,
