@@ -794,7 +794,7 @@ mod tests {
     /// in many directions and sizes, against the limit analysis of the
     /// changed loads itself: never above it, and not trivially low.
     fn check_bounds(s: &Structure, model: &Model) -> usize {
-        let (bodies, links) = everything(&s);
+        let (bodies, links) = everything(s);
         let part = Part {
             bodies: &bodies,
             links: &links,
