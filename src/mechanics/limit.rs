@@ -34,7 +34,7 @@ mod proof;
 
 use super::model::{Bending, Capacity, Model};
 use super::solver::Vec6;
-use super::structure::{End, Structure};
+use super::structure::{End, Link, Structure};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SecondOrderConeT,
@@ -161,16 +161,9 @@ pub fn link_load_factor(
 ) -> f64 {
     let l = &s.links[li];
     let mut prog = Program::new(6, PER_LINK);
-    let half = 0.5 * capacity(s, model, li).side / model.spacing;
-    for (ki, (su, sv)) in CORNERS.iter().enumerate() {
-        let arm = half * (su * l.u + sv * l.v);
-        // Unit forces on side b: a tension n pulls b towards a.
-        for (j, f) in [-l.normal, l.u, l.v].iter().enumerate() {
-            let m = arm.cross(*f);
-            for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
-                prog.push(a, PER_CORNER * ki + j, v);
-            }
-        }
+    let half = half_side(s, model, li);
+    for (col, corner) in corners(l, half) {
+        push_corner(&mut prog, l, 0, col, corner - l.contact, 1.0);
     }
     let action = [force.x, force.y, force.z, moment.x, moment.y, moment.z];
     if action.iter().any(|v| !v.is_finite()) {
@@ -381,6 +374,33 @@ fn capacity<'m>(s: &Structure, model: &'m Model, li: usize) -> &'m Capacity {
     model.capacity_of(s.links[li].is_ground())
 }
 
+/// Half the side of link `li`'s contact square, in units of `d`.
+fn half_side(s: &Structure, model: &Model, li: usize) -> f64 {
+    0.5 * capacity(s, model, li).side / model.spacing
+}
+
+/// Each corner of link `l`'s square (half side `half`, in `d`): its first
+/// column within the link's and its position.
+fn corners(l: &Link, half: f64) -> impl Iterator<Item = (usize, glam::DVec3)> + '_ {
+    CORNERS
+        .iter()
+        .enumerate()
+        .map(move |(ki, (su, sv))| (PER_CORNER * ki, l.contact + half * (su * l.u + sv * l.v)))
+}
+
+/// One corner's three force columns from `col` in the six rows from
+/// `row`: `sign` × the unit forces on side b (a tension n pulls b towards
+/// a, then the two tangential directions) and their moments at `arm`
+/// from the point the rows take moments about.
+fn push_corner(prog: &mut Program, l: &Link, row: usize, col: usize, arm: glam::DVec3, sign: f64) {
+    for (j, f) in [-l.normal, l.u, l.v].iter().enumerate() {
+        let m = arm.cross(*f);
+        for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
+            prog.push(row + a, col + j, sign * v);
+        }
+    }
+}
+
 /// Equilibrium rows: Σ (corner forces on the group) + λ·load = 0.
 fn equilibrium_rows(
     prog: &mut Program,
@@ -394,25 +414,15 @@ fn equilibrium_rows(
     let is_free = |i: usize| frame.row_of[i] != usize::MAX;
     for (k, &li) in links.iter().enumerate() {
         let l = &s.links[li];
-        let half = 0.5 * capacity(s, model, li).side / model.spacing;
-        for (ki, (su, sv)) in CORNERS.iter().enumerate() {
-            let corner = l.contact + half * (su * l.u + sv * l.v);
-            let col = PER_LINK * k + PER_CORNER * ki;
-            // Unit forces on side b: a tension n pulls b towards a.
-            let dirs = [-l.normal, l.u, l.v];
+        let half = half_side(s, model, li);
+        for (col, corner) in corners(l, half) {
             let ends = [(Some(l.a), -1.0), (l.b.body(), 1.0)];
             for (body, sign) in ends {
                 let Some(body) = body.filter(|&b| is_free(b)) else {
                     continue;
                 };
-                let r0 = frame.row_of[body];
                 let arm = corner - (frame.origin)(body);
-                for (j, f) in dirs.iter().enumerate() {
-                    let m = arm.cross(*f);
-                    for (a, v) in [f.x, f.y, f.z, m.x, m.y, m.z].into_iter().enumerate() {
-                        prog.push(r0 + a, col + j, sign * v);
-                    }
-                }
+                push_corner(prog, l, frame.row_of[body], PER_LINK * k + col, arm, sign);
             }
         }
     }
@@ -744,7 +754,7 @@ fn path_to_support(
 /// (normal forces for the bending part, tangential ones for the torsion).
 fn add_couple(cols: &mut [f64], s: &Structure, model: &Model, li: usize, m: glam::DVec3) {
     let l = &s.links[li];
-    let h = 0.5 * capacity(s, model, li).side / model.spacing;
+    let h = half_side(s, model, li);
     let nrm = l.normal;
     let m_n = m.dot(nrm);
     let m_in = m - m_n * nrm;
