@@ -599,7 +599,8 @@ fn every_witness_kept_past_the_construction_stands_in_the_test_lp() {
             let choices: Vec<(u8, u8)> = (0..rng.random_range(1..9))
                 .map(|_| (rng.random_range(0..16), rng.random_range(0..12)))
                 .collect();
-            let s = fcc(&grown(&choices));
+            let cells = grown(&choices);
+            let s = fcc(&cells);
             let a = ungated(&model, &s);
             if a.load_factor.is_some()
                 || a.verdict() != Verdict::Stable
@@ -613,8 +614,7 @@ fn every_witness_kept_past_the_construction_stands_in_the_test_lp() {
                 near += usize::from(b.max_utilisation > 0.5);
                 assert!(
                     lp_stands(&s, &model, Joints::Capacities, Pyramid::Outer),
-                    "{:?}",
-                    grown(&choices)
+                    "{cells:?}"
                 );
             }
         }

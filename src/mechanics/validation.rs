@@ -50,8 +50,6 @@ pub(crate) fn structure_without(
     Structure::build(&scene, movers)
 }
 
-/// The cells of an `nx × ny × nz` block of FCC cells, layer by layer
-/// (the first `nx·ny` are the bottom layer).
 /// A scaffold-like frame of `a × a × h` cubic tiles of side 6 (the
 /// cells on the tiles' edges), fixed at its bottom layer.
 pub(crate) fn frame(a: i32, h: i32) -> Structure {
@@ -71,6 +69,8 @@ pub(crate) fn frame(a: i32, h: i32) -> Structure {
     structure(&FccLattice, None, &cells, &fixed, &[])
 }
 
+/// The cells of an `nx × ny × nz` block of FCC cells, layer by layer
+/// (the first `nx·ny` are the bottom layer).
 fn block(nx: i32, ny: i32, nz: i32) -> Vec<Cell> {
     (0..nz)
         .flat_map(|z| (0..nx).flat_map(move |x| (0..ny).map(move |y| Cell::new(x, y, z))))
@@ -706,9 +706,10 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
 
 #[test]
 fn a_limit_analysis_starts_where_the_last_first_pose_was_solved_and_gives_the_same_factor() {
-    // A frame at an eighth of the adhesion, judged by the limit analysis
-    // (λ = 1.35; the 2 × 2 frame is solved at 1e-8), which stalls at clarabel's own
-    // regularisation (limit::SETTINGS) and is solved at the next setting.
+    // A 3 × 3 × 2-tile frame at an eighth of the adhesion, judged by the
+    // limit analysis (λ = 1.35), which stalls at clarabel's own
+    // regularisation (limit::SETTINGS) and is solved at the next setting
+    // (the 2 × 2 × 2 frame, at this adhesion, is solved at 1e-8).
     let mut model = Model::default_catom();
     model.connector.pressure /= 8.0;
     let s = frame(3, 2);
