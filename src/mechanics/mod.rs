@@ -32,7 +32,7 @@ pub use capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};
 pub use direct::Factor;
 pub use model::{Bending, Capacity, Model};
 pub use solver::Vec6;
-pub use structure::{SceneRef, Structure};
+pub use structure::{End, SceneRef, Structure};
 
 /// rapier's dynamic cross-check of the static analysis: test-only, so the
 /// library does not carry a physics engine it never runs.
