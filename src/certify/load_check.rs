@@ -74,6 +74,19 @@ impl LoadCheck {
         self
     }
 
+    /// This check with the limit analysis off (see
+    /// `Settings::limit_analysis` in the mechanics): components the
+    /// elastic screen cannot clear are bounded, not proved. Not for
+    /// certification: for a study that then proves the steps that matter.
+    fn without_limit_analysis(self) -> LoadCheck {
+        self.analyzer
+            .lock()
+            .expect("analyser lock")
+            .settings
+            .limit_analysis = false;
+        self
+    }
+
     fn analyse(
         &self,
         world: &World,
@@ -336,6 +349,9 @@ pub struct RangedReplay<'a> {
     model: Model,
     load_factor_tolerance: f64,
     range: usize,
+    /// Whether [`RangedReplay::run`] runs the limit analysis (see
+    /// [`RangedReplay::bounds_only`]).
+    limit_analysis: bool,
     /// The scene at each range's first step (0-based step, world).
     starts: Vec<(usize, World)>,
     /// The final configuration.
@@ -374,9 +390,53 @@ impl<'a> RangedReplay<'a> {
             model,
             load_factor_tolerance,
             range,
+            limit_analysis: true,
             starts,
             last: world,
         })
+    }
+
+    /// This replay with the limit analysis off in [`RangedReplay::run`]:
+    /// a step's `max_utilisation` is then an upper bound where the
+    /// elastic screen could not clear a component (`Analysis::bounded`),
+    /// and [`RangedReplay::run_step`] proves the steps that matter.
+    pub fn bounds_only(mut self) -> RangedReplay<'a> {
+        self.limit_analysis = false;
+        self
+    }
+
+    /// Step `step` alone (1-based; the number of steps + 1 is the final
+    /// configuration), analysed from scratch with the limit analysis on:
+    /// the scene is replayed (lattice only) from the start of its range.
+    pub fn run_step<T>(
+        &self,
+        step: usize,
+        visit: &(dyn Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync),
+    ) -> Result<T, crate::error::InputError> {
+        let check = LoadCheck::at_spacing(self.model.clone(), false)
+            .with_load_factor_tolerance(self.load_factor_tolerance);
+        let n = self.schedule.steps.len();
+        if step == n + 1 {
+            let (s, a) = check.analyse(&self.last, &FxHashSet::default(), &[]);
+            return Ok(visit(step, &s, &a, &StepOutcome::default()));
+        }
+        let k = step
+            .checked_sub(1)
+            .filter(|&k| k < n)
+            .ok_or_else(|| crate::error::InputError::new(format!("no step {step} to analyse")))?;
+        let (first, start) = &self.starts[k / self.range];
+        let mut w = start.clone();
+        for j in *first..k {
+            super::advance(&mut w, self.schedule, j, |_| ())?;
+        }
+        let (seen, _, _) = super::advance(&mut w, self.schedule, k, |ctx| {
+            let mut out = StepOutcome::of_plan(ctx.plan);
+            super::LatticeCheck.check(ctx, &mut out);
+            let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
+            let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
+            visit(step, &s, &a, &out)
+        })?;
+        Ok(seen)
     }
 
     /// How many jobs: the ranges and the final configuration.
@@ -407,8 +467,11 @@ impl<'a> RangedReplay<'a> {
         visit: &(dyn Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync),
         tick: &(dyn Fn() + Sync),
     ) -> Result<Vec<T>, crate::error::InputError> {
-        let check = LoadCheck::at_spacing(self.model.clone(), true)
+        let mut check = LoadCheck::at_spacing(self.model.clone(), true)
             .with_load_factor_tolerance(self.load_factor_tolerance);
+        if !self.limit_analysis {
+            check = check.without_limit_analysis();
+        }
         let n = self.schedule.steps.len();
         let Some((first, start)) = self.starts.get(job) else {
             let (s, a) = check.analyse(&self.last, &FxHashSet::default(), &[]);

@@ -53,6 +53,13 @@ pub struct Args {
     /// [0, 0.5); which b are safe stays exact. 0 is exact.
     #[arg(long, default_value_t = 0.0, value_name = "FRACTION")]
     load_factor_tolerance: f64,
+    /// Limit-analyse only the steps that could be a row's worst: every
+    /// step's elastic screen first, then the steps it could not clear,
+    /// highest bound first, until no bound left exceeds the worst proved.
+    /// Rows, verdicts and pressures are those of judging every step; only
+    /// rank 0 judges the steps (its threads) when run under MPI.
+    #[arg(long)]
+    worst_only: bool,
 }
 
 /// `--pressure` in kPa as the model's pressure in Pa: positive and finite
@@ -111,6 +118,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         &generate,
         &progress,
         tolerance,
+        a.worst_only,
         &|order, job| {
             let timed = |t: usize| {
                 let clock = std::time::Instant::now();
@@ -136,7 +144,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             })
             .into());
     }
-    let st = b_study::assemble(&a.family, &m, rows, unplanned, tolerance);
+    let st = b_study::assemble(&a.family, &m, rows, unplanned, tolerance, a.worst_only);
     print!("{}", st.table());
     #[cfg(feature = "render")]
     if let Some(p) = &a.plot {

@@ -100,6 +100,10 @@ pub struct Analysis {
     pub load_factor_lower: Option<f64>,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
+    /// Components the screen could not clear and the limit analysis did
+    /// not judge ([`Settings::limit_analysis`] off): `max_utilisation` is
+    /// then an upper bound of the step's, and the verdict is not proved.
+    pub bounded: usize,
     /// Poses between samples judged one by one ([`Structure::between`]):
     /// those of the intervals a bound of the whole interval did not clear.
     pub between_poses: usize,
@@ -225,6 +229,15 @@ pub struct Settings {
     /// found is not solved: verdicts stay exact (a skipped pose holds),
     /// the exact factor is at least (1 − tolerance) × the reported one.
     pub load_factor_tolerance: f64,
+    /// Run the limit analysis where the screen cannot clear a component.
+    /// Off, such a component is not solved: its utilisation is the
+    /// screen's upper bound of `1/λ` at its worst pose (the elastic field
+    /// scaled until the corners carry it: `1/λ ≤` that bound, by the
+    /// lower-bound theorem; ∞ where no scaling does), its verdict is
+    /// not proved, and [`Analysis::bounded`] counts it. For a study that
+    /// needs only the worst step exactly (`b-study --worst-only`): the
+    /// bounds of every step say which steps can be the worst.
+    pub limit_analysis: bool,
 }
 
 impl Default for Settings {
@@ -237,6 +250,7 @@ impl Default for Settings {
             envelope: true,
             corner_gate: true,
             load_factor_tolerance: 0.0,
+            limit_analysis: true,
         }
     }
 }
@@ -595,7 +609,22 @@ impl Analyzer {
             }
             out.between_poses += screen.between_judged;
             out.sampled_only += usize::from(screen.sampled_only);
-            if !screen.failing.is_empty() {
+            if !screen.failing.is_empty() && !self.settings.limit_analysis {
+                // The screen's bound of 1/λ (worst pose first) stands for
+                // the component's utilisation; nothing is proved here.
+                let bound = screen.failing[0].1;
+                out.bounded += 1;
+                let outcome = LimitOutcome {
+                    rigid: f64::INFINITY,
+                    capacities: 1.0 / bound,
+                    admissible: screen.admissible,
+                    runs: 0,
+                    partial: false,
+                    lower: 1.0 / bound,
+                    setting: self.limit_setting,
+                };
+                limits.push((c, outcome));
+            } else if !screen.failing.is_empty() {
                 let mut limit = self.limit(s, &comps, c, &screen.failing);
                 self.limit_setting = limit.setting;
                 limit.admissible = screen.admissible;

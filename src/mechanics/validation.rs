@@ -725,3 +725,37 @@ fn a_limit_analysis_starts_where_the_last_first_pose_was_solved_and_gives_the_sa
     assert!(first.load_factor.unwrap() > 1.0, "{:?}", first.load_factor);
     assert_eq!(analyzer.limit_setting(), 1);
 }
+
+#[test]
+fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_from_above() {
+    // A 2 × 2 × 2-tile frame the elastic screen cannot clear, holding
+    // plastically (an eighth of the adhesion) and failing (a sixteenth):
+    // without the limit analysis its utilisation is the screen's bound,
+    // never below the proved 1/λ, and nothing is proved (`bounded`).
+    let s = frame(2, 2);
+    for divisor in [8.0, 16.0] {
+        let mut model = Model::default_catom();
+        model.connector.pressure /= divisor;
+        let proved = Analyzer::new(model.clone(), false).analyse(&s);
+        let mut analyzer = Analyzer::new(model, false);
+        analyzer.settings.limit_analysis = false;
+        let bounded = analyzer.analyse(&s);
+        assert!(proved.limit_analyses >= 1 && proved.bounded == 0, "{proved:?}");
+        assert_eq!((bounded.limit_analyses, bounded.bounded), (0, 1));
+        let lambda = proved.load_factor.expect("judged by the limit analysis");
+        assert_eq!(lambda > 1.0, divisor == 8.0, "{divisor}: λ = {lambda}");
+        assert!(
+            (proved.max_utilisation - 1.0 / lambda).abs() <= 1e-12 * proved.max_utilisation,
+            "{divisor}: {} against 1/λ = {}",
+            proved.max_utilisation,
+            1.0 / lambda
+        );
+        assert!(
+            bounded.max_utilisation >= proved.max_utilisation,
+            "{divisor}: bound {} below the proved {}",
+            bounded.max_utilisation,
+            proved.max_utilisation
+        );
+        assert!(bounded.max_utilisation > 1.0, "the screen failed: its bound is above 1");
+    }
+}

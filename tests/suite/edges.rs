@@ -455,11 +455,12 @@ fn the_b_study_spares_limit_analyses_within_its_tolerance_and_keeps_its_verdicts
             |_| Ok(plastic_cantilever()),
             &Reporter::silent(),
             tolerance,
+            false,
             &on_threads,
         )
         .unwrap()
         .expect("threads fold the rows");
-        assemble("cantilever", &model, rows, unplanned, tolerance)
+        assemble("cantilever", &model, rows, unplanned, tolerance, false)
     };
     let (exact, spared) = (study(0.0), study(0.05));
     let (e, t) = (&exact.rows[0], &spared.rows[0]);
