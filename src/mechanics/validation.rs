@@ -740,7 +740,10 @@ fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_fr
         let mut analyzer = Analyzer::new(model, false);
         analyzer.settings.limit_analysis = false;
         let bounded = analyzer.analyse(&s);
-        assert!(proved.limit_analyses >= 1 && proved.bounded == 0, "{proved:?}");
+        assert!(
+            proved.limit_analyses >= 1 && proved.bounded == 0,
+            "{proved:?}"
+        );
         assert_eq!((bounded.limit_analyses, bounded.bounded), (0, 1));
         let lambda = proved.load_factor.expect("judged by the limit analysis");
         assert_eq!(lambda > 1.0, divisor == 8.0, "{divisor}: λ = {lambda}");
@@ -756,6 +759,9 @@ fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_fr
             bounded.max_utilisation,
             proved.max_utilisation
         );
-        assert!(bounded.max_utilisation > 1.0, "the screen failed: its bound is above 1");
+        assert!(
+            bounded.max_utilisation > 1.0,
+            "the screen failed: its bound is above 1"
+        );
     }
 }

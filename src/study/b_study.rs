@@ -507,7 +507,11 @@ fn prove_worst(
             .total_cmp(&a.max_utilisation)
             .then((r, a.step).cmp(&(q, b.step)))
     });
-    progress.start("worst steps proved", candidates.len() as u64);
+    // Most candidates are never judged: the count is an upper limit.
+    progress.start(
+        "bounded steps judged, highest bound first (until none left can raise its row's worst)",
+        candidates.len() as u64,
+    );
     let mut next = candidates.into_iter();
     loop {
         let batch: Vec<(usize, usize)> = next
