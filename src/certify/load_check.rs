@@ -105,6 +105,33 @@ impl LoadCheck {
         let a = self.analyzer.lock().expect("analyser lock").analyse(&s);
         (s, a)
     }
+
+    /// Step `step` (1-based) at the start of `ctx`: its lattice findings
+    /// and the mechanics of its structure, movers hanging, for `visit`.
+    fn visit_step<T>(
+        &self,
+        ctx: &StepContext<'_>,
+        step: usize,
+        visit: impl FnOnce(usize, &Structure, &Analysis, &StepOutcome) -> T,
+    ) -> T {
+        let mut out = StepOutcome::of_plan(ctx.plan);
+        super::LatticeCheck.check(ctx, &mut out);
+        let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
+        let (s, a) = self.analyse(ctx.world, &ctx.plan.moving, &movers);
+        visit(step, &s, &a, &out)
+    }
+
+    /// The final configuration `world`, reported as step `step`, for
+    /// `visit`.
+    fn visit_final<T>(
+        &self,
+        world: &World,
+        step: usize,
+        visit: impl FnOnce(usize, &Structure, &Analysis, &StepOutcome) -> T,
+    ) -> T {
+        let (s, a) = self.analyse(world, &FxHashSet::default(), &[]);
+        visit(step, &s, &a, &StepOutcome::default())
+    }
 }
 
 /// Describes the critical element of an analysis as a violation detail.
@@ -296,11 +323,7 @@ pub fn replay(
     let mut world = World::initial(schedule)?;
     for k in 0..schedule.steps.len() {
         let (_, _, clashes) = super::advance(&mut world, schedule, k, |ctx| {
-            let mut out = StepOutcome::of_plan(ctx.plan);
-            super::LatticeCheck.check(ctx, &mut out);
-            let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
-            let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
-            visit(k + 1, &s, &a, &out);
+            check.visit_step(ctx, k + 1, &mut visit)
         })?;
         if let Some(clash) = clashes.first() {
             return Err(crate::error::InputError::new(format!(
@@ -310,8 +333,7 @@ pub fn replay(
             )));
         }
     }
-    let (s, a) = check.analyse(&world, &FxHashSet::default(), &[]);
-    visit(schedule.steps.len() + 1, &s, &a, &StepOutcome::default());
+    check.visit_final(&world, schedule.steps.len() + 1, visit);
     Ok(())
 }
 
@@ -417,8 +439,7 @@ impl<'a> RangedReplay<'a> {
             .with_load_factor_tolerance(self.load_factor_tolerance);
         let n = self.schedule.steps.len();
         if step == n + 1 {
-            let (s, a) = check.analyse(&self.last, &FxHashSet::default(), &[]);
-            return Ok(visit(step, &s, &a, &StepOutcome::default()));
+            return Ok(check.visit_final(&self.last, step, visit));
         }
         let k = step
             .checked_sub(1)
@@ -430,11 +451,7 @@ impl<'a> RangedReplay<'a> {
             super::advance(&mut w, self.schedule, j, |_| ())?;
         }
         let (seen, _, _) = super::advance(&mut w, self.schedule, k, |ctx| {
-            let mut out = StepOutcome::of_plan(ctx.plan);
-            super::LatticeCheck.check(ctx, &mut out);
-            let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
-            let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
-            visit(step, &s, &a, &out)
+            check.visit_step(ctx, step, visit)
         })?;
         Ok(seen)
     }
@@ -474,19 +491,15 @@ impl<'a> RangedReplay<'a> {
         }
         let n = self.schedule.steps.len();
         let Some((first, start)) = self.starts.get(job) else {
-            let (s, a) = check.analyse(&self.last, &FxHashSet::default(), &[]);
+            let found = check.visit_final(&self.last, n + 1, visit);
             tick();
-            return Ok(vec![visit(n + 1, &s, &a, &StepOutcome::default())]);
+            return Ok(vec![found]);
         };
         let mut w = start.clone();
         let mut found = Vec::new();
         for k in *first..(first + self.range).min(n) {
             let (seen, _, _) = super::advance(&mut w, self.schedule, k, |ctx| {
-                let mut out = StepOutcome::of_plan(ctx.plan);
-                super::LatticeCheck.check(ctx, &mut out);
-                let movers: Vec<MoverSpec> = ctx.plan.resolved_moves();
-                let (s, a) = check.analyse(ctx.world, &ctx.plan.moving, &movers);
-                visit(k + 1, &s, &a, &out)
+                check.visit_step(ctx, k + 1, visit)
             })?;
             tick();
             found.push(seen);

@@ -609,23 +609,13 @@ impl Analyzer {
             }
             out.between_poses += screen.between_judged;
             out.sampled_only += usize::from(screen.sampled_only);
-            if !screen.failing.is_empty() && !self.settings.limit_analysis {
-                // The screen's bound of 1/λ (worst pose first) stands for
-                // the component's utilisation; nothing is proved here.
-                let bound = screen.failing[0].1;
-                out.bounded += 1;
-                let outcome = LimitOutcome {
-                    rigid: f64::INFINITY,
-                    capacities: 1.0 / bound,
-                    admissible: screen.admissible,
-                    runs: 0,
-                    partial: false,
-                    lower: 1.0 / bound,
-                    setting: self.limit_setting,
+            if !screen.failing.is_empty() {
+                let mut limit = if self.settings.limit_analysis {
+                    self.limit(s, &comps, c, &screen.failing)
+                } else {
+                    out.bounded += 1;
+                    self.bounded(&screen.failing)
                 };
-                limits.push((c, outcome));
-            } else if !screen.failing.is_empty() {
-                let mut limit = self.limit(s, &comps, c, &screen.failing);
                 self.limit_setting = limit.setting;
                 limit.admissible = screen.admissible;
                 out.limit_analyses += limit.runs;
@@ -1108,6 +1098,23 @@ impl Analyzer {
             sliding,
             force: force.to_array(),
             moment: moment.to_array(),
+        }
+    }
+
+    /// In place of [`Analyzer::limit`] with `Settings::limit_analysis`
+    /// off: the screen's bound of `1/λ` at the worst failing pose (listed
+    /// first) stands for the component's utilisation. Nothing is solved or
+    /// proved: no rigid factor, no runs.
+    fn bounded(&self, failing: &[(Option<usize>, f64)]) -> LimitOutcome {
+        let bound = failing[0].1;
+        LimitOutcome {
+            rigid: f64::INFINITY,
+            capacities: 1.0 / bound,
+            admissible: 0.0,
+            runs: 0,
+            partial: false,
+            lower: 1.0 / bound,
+            setting: self.limit_setting,
         }
     }
 
