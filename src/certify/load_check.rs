@@ -437,6 +437,38 @@ impl<'a> RangedReplay<'a> {
     ) -> Result<T, crate::error::InputError> {
         let check = LoadCheck::at_spacing(self.model.clone(), false)
             .with_load_factor_tolerance(self.load_factor_tolerance);
+        self.step_with(&check, step, visit)
+    }
+
+    /// Step `step` alone as [`RangedReplay::run_step`], with the limit
+    /// analysis off and each bound of `1/λ` tightened by a region's limit
+    /// analysis of `hops` links until one stays above `until`
+    /// (`Settings::region_hops`, `region_until` in the mechanics): whether
+    /// the step can exceed `until`, at a fraction of a judgement's cost.
+    pub fn bound_step<T>(
+        &self,
+        step: usize,
+        hops: usize,
+        until: f64,
+        visit: &(dyn Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync),
+    ) -> Result<T, crate::error::InputError> {
+        let check = LoadCheck::at_spacing(self.model.clone(), false)
+            .with_load_factor_tolerance(self.load_factor_tolerance)
+            .without_limit_analysis();
+        {
+            let mut analyzer = check.analyzer.lock().expect("analyser lock");
+            analyzer.settings.region_hops = hops;
+            analyzer.settings.region_until = until;
+        }
+        self.step_with(&check, step, visit)
+    }
+
+    fn step_with<T>(
+        &self,
+        check: &LoadCheck,
+        step: usize,
+        visit: &(dyn Fn(usize, &Structure, &Analysis, &StepOutcome) -> T + Sync),
+    ) -> Result<T, crate::error::InputError> {
         let n = self.schedule.steps.len();
         if step == n + 1 {
             return Ok(check.visit_final(&self.last, step, visit));

@@ -238,6 +238,17 @@ pub struct Settings {
     /// needs only the worst step exactly (`b-study --worst-only`): the
     /// bounds of every step say which steps can be the worst.
     pub limit_analysis: bool,
+    /// With the limit analysis off: how many links beyond the links the
+    /// elastic field overloads the region of [`Analyzer::region_bound`]
+    /// reaches (0: no region, the elastic bound alone). A region costs a
+    /// small limit analysis per failing pose, so a study asks for it only
+    /// where the elastic bound is not enough ([`REGION_HOPS`]).
+    pub region_hops: usize,
+    /// With a region: the poses' bounds are tightened, worst first, only
+    /// until one stays above this (the component's bound is then above it
+    /// whatever the other poses give): a study that asks whether a step
+    /// can exceed a known worst stops there.
+    pub region_until: f64,
 }
 
 impl Default for Settings {
@@ -251,9 +262,21 @@ impl Default for Settings {
             corner_gate: true,
             load_factor_tolerance: 0.0,
             limit_analysis: true,
+            region_hops: 0,
+            region_until: f64::INFINITY,
         }
     }
 }
+
+/// The [`Settings::region_hops`] a study asks for: on the sandcastle at
+/// b = 7, one to three links gave the exact `1/λ` at step 400 (3.4358,
+/// the elastic bound ∞) and 1.93, 1.93, 1.72 at step 600 (exact 1.305),
+/// at 1.4–2.3 s and 3.9–7.5 s against a limit analysis's 3.5 s and 126 s.
+pub const REGION_HOPS: usize = 2;
+
+/// Links outside a region that [`Analyzer::region_bound`] asks one by one
+/// (a few SOCP variables each) before it settles for a factor of 1.
+const REGION_LINK_CHECKS: usize = 64;
 
 /// CG iterations with a kept factor before a fresh factorisation is made
 /// instead. A solve with the factor costs about 1/15 of factoring on the
@@ -343,6 +366,98 @@ fn link_stiffness(link: &Link, k: &Springs) -> Block {
     d.fixed_view_mut::<3, 3>(0, 0).copy_from(&dt);
     d.fixed_view_mut::<3, 3>(3, 3).copy_from(&dr);
     d
+}
+
+/// Joins every cluster of the region `inside` (bodies joined by links
+/// with no side outside it) that no support holds to a support (a fixed
+/// body or the ground) by a shortest path of `links`: a cluster held only
+/// by the elastic actions across its boundary would balance them to the
+/// elastic solve's round-off alone, which the limit analysis's proof
+/// cannot close (its bodies' equations have no support to take the
+/// rest). `ends` gives a link's free ends (`None`: a support).
+fn anchor_region(
+    s: &Structure,
+    links: &[usize],
+    ends: &dyn Fn(usize) -> [Option<usize>; 2],
+    inside: &mut [bool],
+) {
+    let n = s.bodies.len();
+    let mut at: Vec<Vec<usize>> = vec![Vec::new(); n];
+    // Breadth first from the bodies a support holds: each body's
+    // neighbour towards the nearest support.
+    let (mut dist, mut towards) = (vec![usize::MAX; n], vec![usize::MAX; n]);
+    let mut queue = std::collections::VecDeque::new();
+    for &li in links {
+        let e = ends(li);
+        for &i in e.iter().flatten() {
+            at[i].push(li);
+            if e.iter().any(Option::is_none) && dist[i] == usize::MAX {
+                dist[i] = 0;
+                queue.push_back(i);
+            }
+        }
+    }
+    while let Some(i) = queue.pop_front() {
+        for &li in &at[i] {
+            for j in ends(li).into_iter().flatten() {
+                if dist[j] == usize::MAX {
+                    dist[j] = dist[i] + 1;
+                    towards[j] = i;
+                    queue.push_back(j);
+                }
+            }
+        }
+    }
+    loop {
+        // The region's bodies held through its own links.
+        let mut held = vec![false; n];
+        let mut stack: Vec<usize> = (0..n).filter(|&i| inside[i] && dist[i] == 0).collect();
+        for &i in &stack {
+            held[i] = true;
+        }
+        while let Some(i) = stack.pop() {
+            for &li in &at[i] {
+                for j in ends(li).into_iter().flatten() {
+                    if inside[j] && !held[j] {
+                        held[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        let Some(mut i) = (0..n)
+            .filter(|&i| inside[i] && !held[i] && dist[i] != usize::MAX)
+            .min_by_key(|&i| dist[i])
+        else {
+            return;
+        };
+        while dist[i] > 0 && !held[i] {
+            i = towards[i];
+            inside[i] = true;
+        }
+    }
+}
+
+/// The largest relative residual `‖f − K q‖ / ‖f‖` at which `q` counts as
+/// an equilibrium of `K q = f`. The solves meet 1e-10 (CG) or round-off
+/// (a fresh factor refined); a field further out is not balanced and
+/// cannot be a witness of the lower-bound theorem.
+pub const WITNESS_RESIDUAL: f64 = 1e-8;
+
+/// Whether `q` balances `f` under `k` within [`WITNESS_RESIDUAL`] of
+/// `‖f‖`, from the residual computed afresh (NaN: no).
+fn balanced(k: &BlockMatrix, f: &[Vec6], q: &[Vec6]) -> bool {
+    if k.is_empty() {
+        return true;
+    }
+    let mut kq = vec![Vec6::zeros(); f.len()];
+    k.mul(q, &mut kq);
+    let (mut r2, mut f2) = (0.0, 0.0);
+    for (a, b) in kq.iter().zip(f) {
+        r2 += (b - a).norm_squared();
+        f2 += b.norm_squared();
+    }
+    r2.sqrt() <= WITNESS_RESIDUAL * f2.sqrt()
 }
 
 /// Loads of one structure's modules (units of `W`, moments in `W·d`), each
@@ -817,7 +932,183 @@ impl Analyzer {
             }
         }
         screen.failing.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if !self.settings.limit_analysis && self.settings.region_hops > 0 {
+            // Bounds only: each failing pose's elastic field, again.
+            let sf_at = |pose: Option<usize>| -> Vec<Vec6> {
+                let mut sf = Vec::new();
+                match pose {
+                    None => sf.clone_from(&sf_reference),
+                    Some(_) if superpose => superposed(pose, &mut sf),
+                    Some(p) => sf = sf_of(&solutions[p]),
+                }
+                sf
+            };
+            self.tighten(s, comps, c, &st, &slot, &sf_at, &mut screen.failing);
+        }
         (screen, reference)
+    }
+
+    /// With the limit analysis off: the bounds of `1/λ` of the failing
+    /// poses (worst first) tightened by [`Analyzer::region_bound`], worst
+    /// first, until the next pose's bound cannot exceed the largest
+    /// tightened one (the component's bound is the largest over its poses;
+    /// a pose left untightened is at most that), or one stays above
+    /// [`Settings::region_until`]. Sorted again after.
+    #[allow(clippy::too_many_arguments)]
+    fn tighten(
+        &self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        st: &Settled,
+        slot: &[usize],
+        sf_at: &dyn Fn(Option<usize>) -> Vec<Vec6>,
+        failing: &mut [(Option<usize>, f64)],
+    ) {
+        let mut best = 0.0_f64;
+        for (pose, bound) in failing.iter_mut() {
+            if *bound <= best {
+                break;
+            }
+            let sf = sf_at(*pose);
+            // `min` keeps the elastic bound where the region's is NaN.
+            *bound = bound.min(self.region_bound(s, comps, c, st, slot, &sf, *pose));
+            best = best.max(*bound);
+            if !(*bound <= self.settings.region_until) {
+                break;
+            }
+        }
+        failing.sort_by(|a, b| b.1.total_cmp(&a.1));
+    }
+
+    /// An upper bound of `1/λ` of component `c` at `pose` from its
+    /// elastic interface forces `sf` (per active link, at `slot[link]`):
+    /// the limit analysis of the region around the links the elastic field
+    /// overloads (bound of `1/λ` above 1; their free ends and the bodies
+    /// within [`Settings::region_hops`] links of them), with the elastic
+    /// field outside it ([`limit::region_load_factor`]). A link that no
+    /// scaling of its elastic action makes admissible (a ground contact
+    /// pressed off-centre, bound ∞) is inside the region, so its bound
+    /// need not be.
+    #[allow(clippy::too_many_arguments)]
+    fn region_bound(
+        &self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        st: &Settled,
+        slot: &[usize],
+        sf: &[Vec6],
+        pose: Option<usize>,
+    ) -> f64 {
+        let links = &comps.links[c];
+        let bound: Vec<f64> = links
+            .iter()
+            .map(|&li| {
+                if st.released[li] {
+                    return 0.0;
+                }
+                let j = self.judge_link(s, li, &sf[slot[li]]);
+                j.worst.max(severity(j.scale))
+            })
+            .collect();
+        let free = |e: End| match e {
+            End::Body(b) if comps.of(s, e).is_some() => Some(b),
+            _ => None,
+        };
+        let ends = |li: usize| {
+            let l = &s.links[li];
+            [free(End::Body(l.a)), free(l.b)]
+        };
+        let mut inside = vec![false; s.bodies.len()];
+        for (&li, &b) in links.iter().zip(&bound) {
+            if overloaded(b) {
+                for i in ends(li).into_iter().flatten() {
+                    inside[i] = true;
+                }
+            }
+        }
+        for _ in 0..self.settings.region_hops {
+            let reached: Vec<usize> = links
+                .iter()
+                .filter_map(|&li| match ends(li) {
+                    [Some(a), Some(b)] if inside[a] != inside[b] => {
+                        Some(if inside[a] { b } else { a })
+                    }
+                    _ => None,
+                })
+                .collect();
+            for i in reached {
+                inside[i] = true;
+            }
+        }
+        anchor_region(s, links, &ends, &mut inside);
+        let region: Vec<usize> = comps.bodies[c]
+            .iter()
+            .copied()
+            .filter(|&i| inside[i])
+            .collect();
+        let (mut interior, mut boundary) = (Vec::new(), Vec::new());
+        let mut outside = 0.0_f64;
+        let mut outside_links = Vec::new();
+        for (&li, &b) in links.iter().zip(&bound) {
+            let crosses = ends(li).into_iter().flatten().any(|i| !inside[i]);
+            if !crosses {
+                interior.push(li);
+                continue;
+            }
+            outside = if b.is_nan() { f64::NAN } else { outside.max(b) };
+            if !st.released[li] {
+                outside_links.push(li);
+            }
+            if !st.released[li] && ends(li).into_iter().flatten().any(|i| inside[i]) {
+                boundary.push((li, sf[slot[li]]));
+            }
+        }
+        let loads = body_loads(s, pose);
+        let lambda = limit::region_load_factor(
+            s,
+            &self.model,
+            &loads,
+            &region,
+            &interior,
+            &boundary,
+            1.0 / outside,
+            self.limit_setting,
+        );
+        // Outside the region the elastic field is scaled by `λ`. The
+        // links' bounds say that each carries it scaled down to `1/b`
+        // (b ≥ 1) or as it is (b < 1): sound for `λ ≤ 1` (every outside
+        // link has b ≤ 1, and a link's admissible forces are convex and
+        // hold 0), not beyond, where a link pulled or sheared against its
+        // adhesion may fail sooner than linearly. So above 1 each outside
+        // link is judged at `λ` times its action, and one that fails
+        // there caps `λ` at the multiple it carries alone
+        // ([`limit::link_load_factor`]; the region's field scaled down
+        // with it stays admissible).
+        if !(lambda > 1.0) {
+            return 1.0 / lambda;
+        }
+        let mut capped = lambda;
+        let mut failed = 0;
+        for &li in &outside_links {
+            let f = sf[slot[li]];
+            let j = self.judge_link(s, li, &(f * lambda));
+            if !(overloaded(j.worst) || overloaded(j.gate)) {
+                continue;
+            }
+            failed += 1;
+            if failed > REGION_LINK_CHECKS {
+                // Too many to ask one by one: λ = 1 is sound (above).
+                return 1.0;
+            }
+            let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
+            capped = lowest(
+                capped,
+                limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1),
+            );
+        }
+        1.0 / capped.max(1.0)
     }
 
     /// The elastic equilibrium of component `c` at the reference pose, its
@@ -936,8 +1227,14 @@ impl Analyzer {
         if st.exact
             && let Some(r) = reference.as_ref()
         {
+            let f = rhs.clone();
             r.factor.solve_many_in_place(&mut rhs);
-            return Some(rhs);
+            // A factor that leaves any solution unbalanced is no witness.
+            return f
+                .iter()
+                .zip(&rhs)
+                .all(|(f, q)| balanced(&st.k, f, q))
+                .then_some(rhs);
         }
         for f_k in &mut rhs {
             let mut q_k = st.q.clone();
@@ -973,57 +1270,71 @@ impl Analyzer {
                 continue;
             }
             let l = &s.links[li];
-            let (load, _, _) = self.load_of(l, sf(li));
-            let cap = self.capacity(l);
-            let u = severity(utilisation(&load, cap).0);
-            j_out.worst = j_out.worst.max(u);
-            // A witness must also be carried by the limit analysis's
-            // corner forces (torsion on a square pressed off-centre). The
-            // closed-form construction is one distribution among many:
-            // where it fails within the utilisation, the link alone is
-            // asked whether any distribution carries it (a few SOCP
-            // variables against a limit analysis of the whole component).
-            let mut r = if u > CORNER_FREE_BELOW {
-                severity(corner_ratio(&load, cap))
-            } else {
-                0.0
-            };
-            if self.settings.corner_gate && overloaded(r) && !overloaded(u) {
-                let f = sf(li);
-                let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
-                let carried = limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1);
-                if carried >= 1.0 {
-                    r = 1.0 / carried;
-                }
-            }
-            if self.settings.corner_gate && overloaded(r) {
-                j_out.gate = j_out.gate.max(r);
-                // First scale by `k₀ = max(u, 1)`, which brings the load
-                // within the utilisation (centre of pressure inside the
-                // square); from there the forces scaled down by `k` keep
-                // the centre no further out and the clamp at `pL² − N/k`,
-                // so the corners carry them from `k = r − (r − 1)·N/pL²`
-                // (never for a contact without adhesion, where scaling
-                // changes no ratio).
-                let k0 = u.max(1.0);
-                let scaled = load.scaled(1.0 / k0);
-                let r0 = if k0 > 1.0 {
-                    severity(corner_ratio(&scaled, cap))
-                } else {
-                    r
-                };
-                let p = cap.tension();
-                j_out.scale = j_out.scale.max(if !overloaded(r0) {
-                    k0
-                } else if p > 0.0 {
-                    k0 * (r0 - (r0 - 1.0) * scaled.axial / p)
-                } else {
-                    f64::INFINITY
-                });
-            }
+            let one = self.judge_link(s, li, sf(li));
+            j_out.worst = j_out.worst.max(one.worst);
+            j_out.gate = j_out.gate.max(one.gate);
+            j_out.scale = j_out.scale.max(one.scale);
+            let u = one.worst;
             if first || u > severity(results[j].utilisation) {
                 results[j] = self.link_result(l, sf(li), st.sliding[li]);
             }
+        }
+        j_out
+    }
+
+    /// One link's elastic judgement at a pose from its interface force
+    /// `f`: its utilisation, its corner ratio beyond 1 (0: the corners
+    /// carry it) and the down-scaling from which they do (an upper bound
+    /// of `1/λ` from this link; 0 where they carry it as it is).
+    fn judge_link(&self, s: &Structure, li: usize, f: &Vec6) -> Judged {
+        let mut j_out = Judged::default();
+        let l = &s.links[li];
+        let (load, _, _) = self.load_of(l, f);
+        let cap = self.capacity(l);
+        let u = severity(utilisation(&load, cap).0);
+        j_out.worst = u;
+        // A witness must also be carried by the limit analysis's
+        // corner forces (torsion on a square pressed off-centre). The
+        // closed-form construction is one distribution among many:
+        // where it fails within the utilisation, the link alone is
+        // asked whether any distribution carries it (a few SOCP
+        // variables against a limit analysis of the whole component).
+        let mut r = if u > CORNER_FREE_BELOW {
+            severity(corner_ratio(&load, cap))
+        } else {
+            0.0
+        };
+        if self.settings.corner_gate && overloaded(r) && !overloaded(u) {
+            let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
+            let carried = limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1);
+            if carried >= 1.0 {
+                r = 1.0 / carried;
+            }
+        }
+        if self.settings.corner_gate && overloaded(r) {
+            j_out.gate = r;
+            // First scale by `k₀ = max(u, 1)`, which brings the load
+            // within the utilisation (centre of pressure inside the
+            // square); from there the forces scaled down by `k` keep
+            // the centre no further out and the clamp at `pL² − N/k`,
+            // so the corners carry them from `k = r − (r − 1)·N/pL²`
+            // (never for a contact without adhesion, where scaling
+            // changes no ratio).
+            let k0 = u.max(1.0);
+            let scaled = load.scaled(1.0 / k0);
+            let r0 = if k0 > 1.0 {
+                severity(corner_ratio(&scaled, cap))
+            } else {
+                r
+            };
+            let p = cap.tension();
+            j_out.scale = if !overloaded(r0) {
+                k0
+            } else if p > 0.0 {
+                k0 * (r0 - (r0 - 1.0) * scaled.axial / p)
+            } else {
+                f64::INFINITY
+            };
         }
         j_out
     }
@@ -1551,8 +1862,28 @@ impl Analyzer {
     /// factor, or (incrementally) by CG preconditioned with the component's
     /// kept factor `reference`, falling back to a fresh factor — which then
     /// becomes the kept one — when that does not converge quickly.
+    ///
+    /// What counts is the true residual `f − K q`, computed afresh
+    /// ([`balanced`]): CG's recurrence residual can report convergence
+    /// where a factor of a nearly singular matrix (a mechanism through
+    /// sliding ground contacts) left `q` far from any equilibrium.
     #[allow(clippy::too_many_arguments)]
     fn solve(
+        &mut self,
+        s: &Structure,
+        active: &[usize],
+        k: &BlockMatrix,
+        f: &[Vec6],
+        q: &mut [Vec6],
+        reference: &mut Option<Reference>,
+        out: &mut Analysis,
+    ) -> bool {
+        self.solve_once(s, active, k, f, q, reference, out) && balanced(k, f, q)
+    }
+
+    /// [`Analyzer::solve`] before its residual is checked.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_once(
         &mut self,
         s: &Structure,
         active: &[usize],

@@ -183,6 +183,86 @@ pub fn link_load_factor(
         .map_or(0.0, |p| p.lambda)
 }
 
+/// A lower bound of the load factor of a component from an equilibrium
+/// that is elastic outside a region and solved inside it: the limit
+/// analysis of the free bodies `region` alone, on the links `links` with
+/// no side outside the region and its supports, under `loads` plus the
+/// elastic actions of the links that cross into the rest of the component
+/// (`boundary`: link and its interface force `sf`, the action on side a,
+/// `W` and `W·d` about the contact, as the screen computes it), all
+/// scaled by `λ`, and `λ ≤ outside` (the largest multiple of the elastic
+/// field that every link not in `links` carries). Such a field is in
+/// equilibrium everywhere (the elastic one balances the bodies outside,
+/// the solved one those inside) and within every capacity, so by the
+/// lower-bound theorem the component carries at least this factor. With
+/// the whole component as the region it is the limit analysis itself; a
+/// region around the links the elastic field overloads costs a program of
+/// their size, not of the component's. Proved as [`load_factor`]'s is
+/// (0 where nothing is proved, NaN for NaN input).
+#[allow(clippy::too_many_arguments)]
+pub fn region_load_factor(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    region: &[usize],
+    links: &[usize],
+    boundary: &[(usize, Vec6)],
+    outside: f64,
+    first: usize,
+) -> f64 {
+    if outside.is_nan()
+        || boundary
+            .iter()
+            .any(|(_, f)| f.iter().any(|v| !v.is_finite()))
+    {
+        return f64::NAN;
+    }
+    let mut loads = loads.to_vec();
+    let mut inside = vec![false; s.bodies.len()];
+    for &i in region {
+        inside[i] = true;
+    }
+    for &(li, f) in boundary {
+        let l = &s.links[li];
+        let (force, moment) = (
+            glam::DVec3::new(f[0], f[1], f[2]),
+            glam::DVec3::new(f[3], f[4], f[5]),
+        );
+        // A stretched interface pulls b towards a and a towards b.
+        let sides = [(Some(l.a), 1.0), (l.b.body(), -1.0)];
+        for (body, sign) in sides {
+            let Some(i) = body.filter(|&i| inside[i]) else {
+                continue;
+            };
+            let (fi, mi) = (
+                sign * force,
+                sign * moment + (l.contact - s.bodies[i].centre).cross(sign * force),
+            );
+            let add = Vec6::new(fi.x, fi.y, fi.z, mi.x, mi.y, mi.z);
+            loads[i] += add;
+        }
+    }
+    let part = Part {
+        bodies: region,
+        links,
+    };
+    let Some((mut prog, _)) = program(s, model, &loads, part, false) else {
+        return LAMBDA_CAP.min(outside);
+    };
+    if outside < LAMBDA_CAP {
+        let lam = prog.lam;
+        prog.row(&[(lam, 1.0)], outside.max(0.0));
+    }
+    let to_prove = prog.clone();
+    proof::reserve_pressure(&mut prog);
+    let (r, x) = maximise(prog, first);
+    if r.lambda.is_nan() {
+        return f64::NAN;
+    }
+    x.and_then(|x| proof::prove(&to_prove, &x, r.lambda))
+        .map_or(0.0, |p| p.lambda)
+}
+
 /// Where each free body's six equations start (`usize::MAX` for the
 /// others), and how many groups of six there are. With capacities, every
 /// free body of the part is balanced on its own (moments about its

@@ -739,6 +739,9 @@ fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_fr
         let proved = Analyzer::new(model.clone(), false).analyse(&s);
         let mut analyzer = Analyzer::new(model, false);
         analyzer.settings.limit_analysis = false;
+        // The elastic bound alone (a region's limit analysis tightens it:
+        // the next test).
+        analyzer.settings.region_hops = 0;
         let bounded = analyzer.analyse(&s);
         assert!(
             proved.limit_analyses >= 1 && proved.bounded == 0,
@@ -762,6 +765,57 @@ fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_fr
         assert!(
             bounded.max_utilisation > 1.0,
             "the screen failed: its bound is above 1"
+        );
+    }
+}
+
+/// `s` analysed with the limit analysis off and a region of `hops` links
+/// around the overloaded ones (0: the elastic bound alone).
+fn bound_with_region(model: &Model, s: &Structure, hops: usize) -> f64 {
+    let mut analyzer = Analyzer::new(model.clone(), false);
+    analyzer.settings.limit_analysis = false;
+    analyzer.settings.region_hops = hops;
+    let a = analyzer.analyse(s);
+    assert_eq!(a.limit_analyses, 0);
+    a.max_utilisation
+}
+
+#[test]
+fn a_region_limit_analysis_tightens_the_screens_bound_and_never_passes_the_proved_one() {
+    // The frame the screen cannot clear, holding (an eighth of the
+    // adhesion) and failing (a sixteenth): the bound from a region around
+    // the overloaded links lies between the proved 1/λ and the elastic
+    // bound, strictly below the latter (the region redistributes), and
+    // with the whole frame as the region it is the proved 1/λ.
+    let s = frame(2, 2);
+    for divisor in [8.0, 16.0] {
+        let mut model = Model::default_catom();
+        model.connector.pressure /= divisor;
+        let proved = Analyzer::new(model.clone(), false)
+            .analyse(&s)
+            .max_utilisation;
+        let elastic = bound_with_region(&model, &s, 0);
+        let mut last = elastic;
+        for hops in 1..=3 {
+            let bound = bound_with_region(&model, &s, hops);
+            assert!(
+                bound >= proved * (1.0 - 1e-9),
+                "{divisor}, {hops} hops: bound {bound} below the proved {proved}"
+            );
+            assert!(
+                bound <= elastic,
+                "{divisor}, {hops} hops: {bound} > {elastic}"
+            );
+            last = last.min(bound);
+        }
+        assert!(
+            last < 0.9 * elastic,
+            "{divisor}: the region tightened {elastic} only to {last}"
+        );
+        let whole = bound_with_region(&model, &s, 1000);
+        assert!(
+            (whole - proved).abs() <= 1e-6 * proved,
+            "{divisor}: whole frame {whole} against the proved {proved}"
         );
     }
 }

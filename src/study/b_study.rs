@@ -15,7 +15,7 @@ use crate::certify::StepOutcome;
 use crate::certify::jobs::{self, Done};
 use crate::certify::report::ViolationKind;
 use crate::error::InputError;
-use crate::mechanics::analysis::{Analysis, Critical, Verdict};
+use crate::mechanics::analysis::{Analysis, Critical, REGION_HOPS, Verdict};
 use crate::mechanics::capacity::required_pressure;
 use crate::mechanics::closed_form;
 use crate::mechanics::model::{Bending, Capacity, Model};
@@ -479,6 +479,10 @@ const PROVED_TOGETHER: usize = 4;
 /// utilisation proved: those steps cannot raise it, and a finite bound
 /// proves an equilibrium within capacity scaled by it (so they cannot
 /// lack one, nor, at a bound ≤ 1, fail). An infinite bound sorts first.
+/// Each step's bound is first tightened by a region's limit analysis
+/// ([`RangedReplay::bound_step`], [`REGION_HOPS`] links around the
+/// overloaded ones, stopping at the first pose above the row's worst):
+/// only a step still above the worst is judged in full.
 fn prove_worst(
     studied: &[(Row, RangedReplay<'_>, Capacity, Capacity)],
     per_b: &mut [Vec<StepFinding>],
@@ -526,9 +530,19 @@ fn prove_worst(
         let job = |t: usize| {
             let (r, i) = batch[t];
             let (_, replay, hinge, elastic) = &studied[r];
-            let found = replay.run_step(per_b[r][i].step, &|step, s, a, out| {
+            let finding = |step: usize, s: &Structure, a: &Analysis, out: &StepOutcome| {
                 StepFinding::of(step, s, a, out, hinge, elastic)
-            });
+            };
+            // First the region's bound (a small limit analysis around the
+            // overloaded links per pose): a step it keeps at or below the
+            // row's worst proved cannot raise it and is not judged.
+            let step = per_b[r][i].step;
+            let bounded = replay.bound_step(step, REGION_HOPS, worst[r], &finding)?;
+            let found = if bounded.max_utilisation <= worst[r] {
+                Ok(bounded)
+            } else {
+                replay.run_step(step, &finding)
+            };
             progress.advance(1);
             found
         };
