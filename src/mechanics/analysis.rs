@@ -1878,21 +1878,6 @@ impl Analyzer {
         reference: &mut Option<Reference>,
         out: &mut Analysis,
     ) -> bool {
-        self.solve_once(s, active, k, f, q, reference, out) && balanced(k, f, q)
-    }
-
-    /// [`Analyzer::solve`] before its residual is checked.
-    #[allow(clippy::too_many_arguments)]
-    fn solve_once(
-        &mut self,
-        s: &Structure,
-        active: &[usize],
-        k: &BlockMatrix,
-        f: &[Vec6],
-        q: &mut [Vec6],
-        reference: &mut Option<Reference>,
-        out: &mut Analysis,
-    ) -> bool {
         if k.is_empty() {
             return true;
         }
@@ -1910,12 +1895,13 @@ impl Analyzer {
                     let mut apply = |res: &[Vec6], z: &mut [Vec6]| pre.apply(res, z);
                     let stats = pcg(k, &mut apply, f, q, tol, self.settings.reuse_iterations);
                     out.iterations += stats.iterations;
-                    if stats.converged {
+                    if stats.converged && balanced(k, f, q) {
                         return true;
                     }
                 }
             } else if self.incremental
                 && pcg(k, &mut |r, z| z.copy_from_slice(r), f, q, tol, 0).converged
+                && balanced(k, f, q)
             {
                 // Already at the solution (nothing changed): no factor needed.
                 return true;
@@ -1944,7 +1930,7 @@ impl Analyzer {
                         .collect();
                     *reference = Some(Reference { factor, index });
                 }
-                refined.converged
+                refined.converged && balanced(k, f, q)
             }
             None => {
                 // Not positive definite (a mechanism, e.g. a contact that
@@ -1953,7 +1939,7 @@ impl Analyzer {
                 let stats = jacobi_pcg(k, f, q, tol, 50 * 6 * n + 1000);
                 out.iterations += stats.iterations;
                 // Unconverged, `q` is no equilibrium: no witness.
-                stats.converged
+                stats.converged && balanced(k, f, q)
             }
         }
     }
