@@ -1102,11 +1102,7 @@ impl Analyzer {
                 // Too many to ask one by one: λ = 1 is sound (above).
                 return 1.0;
             }
-            let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
-            capped = lowest(
-                capped,
-                limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1),
-            );
+            capped = lowest(capped, self.link_carries(s, li, &f));
         }
         1.0 / capped.max(1.0)
     }
@@ -1282,6 +1278,14 @@ impl Analyzer {
         j_out
     }
 
+    /// The largest multiple of link `li`'s elastic action (interface force
+    /// `f`, the action on side a) that its corners carry
+    /// ([`limit::link_load_factor`], which takes the action on side b).
+    fn link_carries(&self, s: &Structure, li: usize, f: &Vec6) -> f64 {
+        let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
+        limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1)
+    }
+
     /// One link's elastic judgement at a pose from its interface force
     /// `f`: its utilisation, its corner ratio beyond 1 (0: the corners
     /// carry it) and the down-scaling from which they do (an upper bound
@@ -1305,8 +1309,7 @@ impl Analyzer {
             0.0
         };
         if self.settings.corner_gate && overloaded(r) && !overloaded(u) {
-            let on_b = (-DVec3::new(f[0], f[1], f[2]), -DVec3::new(f[3], f[4], f[5]));
-            let carried = limit::link_load_factor(s, &self.model, li, on_b.0, on_b.1);
+            let carried = self.link_carries(s, li, f);
             if carried >= 1.0 {
                 r = 1.0 / carried;
             }
