@@ -974,7 +974,7 @@ impl Analyzer {
             // `min` keeps the elastic bound where the region's is NaN.
             *bound = bound.min(self.region_bound(s, comps, c, st, slot, &sf, *pose));
             best = best.max(*bound);
-            if !(*bound <= self.settings.region_until) {
+            if bound.is_nan() || *bound > self.settings.region_until {
                 break;
             }
         }
@@ -1086,7 +1086,7 @@ impl Analyzer {
         // there caps `λ` at the multiple it carries alone
         // ([`limit::link_load_factor`]; the region's field scaled down
         // with it stays admissible).
-        if !(lambda > 1.0) {
+        if lambda.is_nan() || lambda <= 1.0 {
             return 1.0 / lambda;
         }
         let mut capped = lambda;
