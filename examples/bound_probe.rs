@@ -28,7 +28,12 @@ fn main() {
                     let t = Instant::now();
                     let r = z.analyse(s);
                     let u = r.links.iter().map(|l| l.utilisation).fold(0.0, f64::max);
-                    (r.max_utilisation, u, r.bounded, t.elapsed().as_secs_f64())
+                    (
+                        r.max_utilisation,
+                        u,
+                        r.region_analyses,
+                        t.elapsed().as_secs_f64(),
+                    )
                 };
                 let mut line = format!(
                     "step {step}: {} bodies, {} links;",
@@ -37,8 +42,9 @@ fn main() {
                 );
                 for hops in 0..=3 {
                     let (bound, u, nb, tb) = run(false, hops);
-                    line +=
-                        &format!(" hops {hops}: {bound:.4} ({nb} bounded, {tb:.2}s, u {u:.4});");
+                    line += &format!(
+                        " hops {hops}: {bound:.4} ({nb} region analyses, {tb:.2}s, u {u:.4});"
+                    );
                 }
                 if std::env::var("EXACT").is_ok() {
                     let (exact, _, _, te) = run(true, 0);

@@ -14,6 +14,7 @@ use super::capacity::{
 use super::direct::Factor;
 use super::limit::{self, Connectors};
 use super::model::{Capacity, Model};
+use super::pose_hull;
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
 use super::structure::{End, Link, Structure};
@@ -118,6 +119,10 @@ pub struct Analysis {
     /// one) and sparse factorisations this analysis took.
     pub iterations: usize,
     pub factorizations: usize,
+    /// Region limit analyses ([`Settings::region_hops`]) this analysis
+    /// took: one per failing pose, or one per corner of the triangle that
+    /// holds the failing poses' mover moments where that is fewer.
+    pub region_analyses: usize,
 }
 
 impl Analysis {
@@ -149,6 +154,15 @@ struct Screen {
 
 /// The settled elastic equilibrium of one component (see
 /// [`Analyzer::settle`]).
+/// A component's poses for [`Analyzer::tighten`]: each pose's elastic
+/// interface forces, and its coordinates (each of its movers' moment
+/// change from the reference along two unit axes across gravity), in
+/// which its loads, and so its elastic field, are affine.
+struct Poses<'a> {
+    at: &'a dyn Fn(Option<usize>) -> Vec<Vec6>,
+    coordinates: &'a dyn Fn(Option<usize>) -> Vec<f64>,
+}
+
 struct Settled {
     k: BlockMatrix,
     /// Displacements at the reference pose.
@@ -510,6 +524,14 @@ fn mover_moment(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
         Some(k) => moment_at(s, h, s.mover_point(h, k)),
         None => worst_lever(hg.path.iter().map(|c| *c - p), s.gravity).cross(s.gravity),
     }
+}
+
+/// `acc += w · x`, `acc` taking `x`'s length when empty.
+fn add_scaled(acc: &mut Vec<Vec6>, x: &[Vec6], w: f64) {
+    if acc.is_empty() {
+        acc.resize(x.len(), Vec6::zeros());
+    }
+    acc.iter_mut().zip(x).for_each(|(a, b)| *a += w * b);
 }
 
 /// Mover `h`'s moment on its pivot (units `W·d`) with its centre at `c`.
@@ -943,17 +965,38 @@ impl Analyzer {
                 }
                 sf
             };
-            self.tighten(s, comps, c, &st, &slot, &sf_at, &mut screen.failing);
+            let coordinates = |pose: Option<usize>| -> Vec<f64> {
+                movers
+                    .iter()
+                    .flat_map(|&h| {
+                        let d = mover_moment(s, h, pose) - mover_moment(s, h, None);
+                        [d.dot(e1), d.dot(e2)]
+                    })
+                    .collect()
+            };
+            let poses = Poses {
+                at: &sf_at,
+                coordinates: &coordinates,
+            };
+            out.region_analyses +=
+                self.tighten(s, comps, c, &st, &slot, &poses, &mut screen.failing);
         }
         (screen, reference)
     }
 
     /// With the limit analysis off: the bounds of `1/λ` of the failing
-    /// poses (worst first) tightened by [`Analyzer::region_bound`], worst
-    /// first, until the next pose's bound cannot exceed the largest
-    /// tightened one (the component's bound is the largest over its poses;
-    /// a pose left untightened is at most that), or one stays above
-    /// [`Settings::region_until`]. Sorted again after.
+    /// poses (worst first) tightened by [`Analyzer::region_bound`]. First,
+    /// where it takes fewer region analyses than the poses, at the corners
+    /// of a triangle that holds the failing poses' mover moments: each pose's
+    /// loads (and elastic field) are a convex combination of the corners',
+    /// so the same combination of the corners' admissible fields, each
+    /// scaled to the largest corner bound, carries the pose's loads scaled
+    /// by it — a bound for every pose at once ([`Analyzer::hull_bound`]).
+    /// Where that bound stays above [`Settings::region_until`], pose by
+    /// pose, worst first, until the next pose's bound cannot exceed the
+    /// largest tightened one (the component's bound is the largest over its
+    /// poses; a pose left untightened is at most that), or one stays above
+    /// `region_until`. Sorted again after; returns the region analyses.
     #[allow(clippy::too_many_arguments)]
     fn tighten(
         &self,
@@ -962,23 +1005,87 @@ impl Analyzer {
         c: usize,
         st: &Settled,
         slot: &[usize],
-        sf_at: &dyn Fn(Option<usize>) -> Vec<Vec6>,
+        poses: &Poses<'_>,
         failing: &mut [(Option<usize>, f64)],
-    ) {
+    ) -> usize {
+        let until = self.settings.region_until;
+        let mut solved = 0;
+        if let Some((bound, n)) = self.hull_bound(s, comps, c, st, slot, poses, failing) {
+            solved += n;
+            if bound <= until {
+                for (_, b) in failing.iter_mut() {
+                    *b = b.min(bound);
+                }
+                failing.sort_by(|a, b| b.1.total_cmp(&a.1));
+                return solved;
+            }
+        }
         let mut best = 0.0_f64;
         for (pose, bound) in failing.iter_mut() {
             if *bound <= best {
                 break;
             }
-            let sf = sf_at(*pose);
+            let sf = (poses.at)(*pose);
+            let loads = body_loads(s, *pose);
             // `min` keeps the elastic bound where the region's is NaN.
-            *bound = bound.min(self.region_bound(s, comps, c, st, slot, &sf, *pose));
+            *bound = bound.min(self.region_bound(s, comps, c, st, slot, &sf, &loads));
+            solved += 1;
             best = best.max(*bound);
-            if bound.is_nan() || *bound > self.settings.region_until {
+            if bound.is_nan() || *bound > until {
                 break;
             }
         }
         failing.sort_by(|a, b| b.1.total_cmp(&a.1));
+        solved
+    }
+
+    /// The region bound at the corners of a triangle (or segment, or
+    /// point) that holds the failing poses' coordinates (each mover's
+    /// moment change along two unit axes across gravity;
+    /// [`pose_hull::enclosing_triangle`]): the largest, valid for every
+    /// failing pose (see [`Analyzer::tighten`]), and the region analyses it
+    /// took; `None` where the poses need as many corners as they are; NaN
+    /// where a corner's bound is. Stops at the first corner above
+    /// [`Settings::region_until`].
+    #[allow(clippy::too_many_arguments)]
+    fn hull_bound(
+        &self,
+        s: &Structure,
+        comps: &Components,
+        c: usize,
+        st: &Settled,
+        slot: &[usize],
+        poses: &Poses<'_>,
+        failing: &[(Option<usize>, f64)],
+    ) -> Option<(f64, usize)> {
+        let points: Vec<Vec<f64>> = failing
+            .iter()
+            .map(|(p, _)| (poses.coordinates)(*p))
+            .collect();
+        let corners = pose_hull::enclosing(&points, points.len().saturating_sub(1))?;
+        let mut bound = 0.0_f64;
+        let mut solved = 0;
+        for corner in &corners {
+            // Loads and field at the corner: the same combination of the
+            // poses' (each pose's field balances its loads, and both are
+            // affine in the coordinates).
+            let (mut loads, mut sf) = (Vec::new(), Vec::new());
+            for &(i, w) in corner {
+                let pose = failing[i].0;
+                add_scaled(&mut loads, &body_loads(s, pose), w);
+                add_scaled(&mut sf, &(poses.at)(pose), w);
+            }
+            let b = self.region_bound(s, comps, c, st, slot, &sf, &loads);
+            solved += 1;
+            if b.is_nan() {
+                return Some((f64::NAN, solved));
+            }
+            bound = bound.max(b);
+            if bound > self.settings.region_until {
+                break;
+            }
+        }
+        Some((bound, solved))
     }
 
     /// An upper bound of `1/λ` of component `c` at `pose` from its
@@ -999,7 +1106,7 @@ impl Analyzer {
         st: &Settled,
         slot: &[usize],
         sf: &[Vec6],
-        pose: Option<usize>,
+        loads: &[Vec6],
     ) -> f64 {
         let links = &comps.links[c];
         let bound: Vec<f64> = links
@@ -1065,11 +1172,10 @@ impl Analyzer {
                 boundary.push((li, sf[slot[li]]));
             }
         }
-        let loads = body_loads(s, pose);
         let lambda = limit::region_load_factor(
             s,
             &self.model,
-            &loads,
+            loads,
             &region,
             &interior,
             &boundary,

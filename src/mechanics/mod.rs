@@ -12,7 +12,10 @@
 //!   ground by active set) with reuse between consecutive steps;
 //! * `solver`, `direct` — preconditioned CG over 6 × 6 blocks and the
 //!   sparse Cholesky factor (faer) that preconditions it;
-//! * `closed_form` — the cantilever bounds the study is checked against.
+//! * `closed_form` — the cantilever bounds the study is checked against;
+//! * `limit`, `proof` — the limit analysis (lower-bound theorem) and the
+//!   proof of its factor; `pose_hull` — a few points holding a step's
+//!   poses, where a region's bound is proved once for all of them.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
@@ -23,6 +26,7 @@ pub(crate) mod closed_form;
 pub(crate) mod direct;
 pub(crate) mod limit;
 pub(crate) mod model;
+pub(crate) mod pose_hull;
 pub(crate) mod reuse;
 pub(crate) mod solver;
 pub(crate) mod structure;

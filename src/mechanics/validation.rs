@@ -769,6 +769,92 @@ fn with_the_limit_analysis_off_a_component_the_screen_cannot_clear_is_bounded_fr
     }
 }
 
+#[test]
+fn a_region_bound_proved_at_the_corners_of_the_poses_hull_holds_at_every_pose() {
+    // One mover swinging 90° at the tip of a branch (every pose failing at
+    // a fifth of the adhesion), and a block resting on the ground with a
+    // mover on its top (at a fortieth): the region's bound from the three
+    // corners of the triangle around the poses' moment changes is never
+    // below the proved 1/λ of any pose (the limit analysis of each pose
+    // alone), and it took three region analyses where pose by pose takes
+    // one per pose.
+    let base = Model::default_catom();
+    let branch = swing(4, Cell::new(5, 0, 0), Cell::new(4, 1, 0), Route::Octagonal);
+    let mut cells = block(3, 3, 3);
+    cells.push(Cell::new(3, 1, 2));
+    let mover = cells.len() as ModuleId;
+    let pivot = cells.iter().position(|c| *c == Cell::new(2, 1, 2)).unwrap() as ModuleId + 1;
+    let motion = Motion::Rotate {
+        from: Cell::new(3, 1, 2),
+        to: FccLattice.neighbour(Cell::new(2, 1, 2), 4),
+        pivot: Cell::new(2, 1, 2),
+        route: Route::Octagonal,
+    };
+    let resting = structure(
+        &FccLattice,
+        Some(Ground { layer: 0 }),
+        &cells,
+        &[],
+        &[(mover, Some(pivot), motion)],
+    );
+    let bounded = |model: &Model, s: &Structure| {
+        let mut analyzer = Analyzer::new(model.clone(), false);
+        analyzer.settings.limit_analysis = false;
+        analyzer.settings.region_hops = 1;
+        analyzer.analyse(s)
+    };
+    for (s, divisors) in [
+        (&branch, [5.0; 1].to_vec()),
+        (&resting, vec![40.0, 100.0, 300.0, 1000.0]),
+    ] {
+        // The first adhesion, weakest last, at which the screen fails.
+        let weak = |d: f64| {
+            let mut model = base.clone();
+            model.connector.pressure /= d;
+            model
+        };
+        let divisor = *divisors
+            .iter()
+            .find(|&&d| bounded(&weak(d), s).bounded > 0)
+            .expect("the screen fails at some adhesion");
+        let model = weak(divisor);
+        let n = s.hanging[0].path.len();
+        assert!(n > 3, "{n} poses");
+        let proved = per_pose_proved(&model, s);
+        let a = bounded(&model, s);
+        assert_eq!(
+            a.region_analyses, 3,
+            "{divisor}: the poses' hull was not used"
+        );
+        assert!(
+            a.max_utilisation >= proved * (1.0 - 1e-9),
+            "{divisor}: bound {} below the proved {proved}",
+            a.max_utilisation
+        );
+        assert!(
+            a.max_utilisation <= 1.5 * proved,
+            "{divisor}: bound {} against the proved {proved}",
+            a.max_utilisation
+        );
+    }
+}
+
+/// The largest proved 1/λ over `s`'s poses, each analysed alone (the
+/// mover held there) by the limit analysis.
+fn per_pose_proved(model: &Model, s: &Structure) -> f64 {
+    let n = s.hanging[0].path.len();
+    (0..n)
+        .map(|k| {
+            let mut t = s.clone();
+            t.hanging[0].path = vec![s.hanging[0].path[k]];
+            t.hanging[0].hull.clear();
+            let mut a = Analyzer::new(model.clone(), false);
+            a.settings.envelope = false;
+            a.analyse(&t).max_utilisation
+        })
+        .fold(0.0, f64::max)
+}
+
 /// `s` analysed with the limit analysis off and a region of `hops` links
 /// around the overloaded ones (0: the elastic bound alone).
 fn bound_with_region(model: &Model, s: &Structure, hops: usize) -> f64 {

@@ -505,10 +505,18 @@ fn prove_worst(
                 .map(move |i| (r, i))
         })
         .collect();
+    // Among equal bounds (most often ∞: a ground contact pressed
+    // off-centre, which no scaling of the elastic field carries), the
+    // highest elastic loads first (the pressure they need): those steps are
+    // the likeliest worst, and a high worst proved early spares the rest.
     candidates.sort_by(|&(r, i), &(q, j)| {
         let (a, b) = (&per_b[r][i], &per_b[q][j]);
         b.max_utilisation
             .total_cmp(&a.max_utilisation)
+            .then(
+                b.min_pressure_rigid_hinge
+                    .total_cmp(&a.min_pressure_rigid_hinge),
+            )
             .then((r, a.step).cmp(&(q, b.step)))
     });
     // Most candidates are never judged: the count is an upper limit.
