@@ -154,11 +154,19 @@ struct Screen {
 
 /// The settled elastic equilibrium of one component (see
 /// [`Analyzer::settle`]).
-/// A component's poses for [`Analyzer::tighten`]: each pose's elastic
-/// interface forces, and its coordinates (each of its movers' moment
-/// change from the reference along two unit axes across gravity), in
-/// which its loads, and so its elastic field, are affine.
-struct Poses<'a> {
+/// A failing component as [`Analyzer::tighten`] sees it: component `c`
+/// of `s`, its settled active set, each active link's slot in an
+/// interface-force vector, and per pose its elastic interface forces and
+/// its coordinates (each of its movers' moment change from the reference
+/// along two unit axes across gravity), in which its loads, and so its
+/// elastic field, are affine.
+#[derive(Clone, Copy)]
+struct Failing<'a> {
+    s: &'a Structure,
+    comps: &'a Components,
+    c: usize,
+    st: &'a Settled,
+    slot: &'a [usize],
     at: &'a dyn Fn(Option<usize>) -> Vec<Vec6>,
     coordinates: &'a dyn Fn(Option<usize>) -> Vec<f64>,
 }
@@ -974,12 +982,16 @@ impl Analyzer {
                     })
                     .collect()
             };
-            let poses = Poses {
+            let component = Failing {
+                s,
+                comps,
+                c,
+                st: &st,
+                slot: &slot,
                 at: &sf_at,
                 coordinates: &coordinates,
             };
-            out.region_analyses +=
-                self.tighten(s, comps, c, &st, &slot, &poses, &mut screen.failing);
+            out.region_analyses += self.tighten(&component, &mut screen.failing);
         }
         (screen, reference)
     }
@@ -997,20 +1009,10 @@ impl Analyzer {
     /// largest tightened one (the component's bound is the largest over its
     /// poses; a pose left untightened is at most that), or one stays above
     /// `region_until`. Sorted again after; returns the region analyses.
-    #[allow(clippy::too_many_arguments)]
-    fn tighten(
-        &self,
-        s: &Structure,
-        comps: &Components,
-        c: usize,
-        st: &Settled,
-        slot: &[usize],
-        poses: &Poses<'_>,
-        failing: &mut [(Option<usize>, f64)],
-    ) -> usize {
+    fn tighten(&self, k: &Failing<'_>, failing: &mut [(Option<usize>, f64)]) -> usize {
         let until = self.settings.region_until;
         let mut solved = 0;
-        if let Some((bound, n)) = self.hull_bound(s, comps, c, st, slot, poses, failing) {
+        if let Some((bound, n)) = self.hull_bound(k, failing) {
             solved += n;
             if bound <= until {
                 for (_, b) in failing.iter_mut() {
@@ -1025,10 +1027,10 @@ impl Analyzer {
             if *bound <= best {
                 break;
             }
-            let sf = (poses.at)(*pose);
-            let loads = body_loads(s, *pose);
+            let sf = (k.at)(*pose);
+            let loads = body_loads(k.s, *pose);
             // `min` keeps the elastic bound where the region's is NaN.
-            *bound = bound.min(self.region_bound(s, comps, c, st, slot, &sf, &loads));
+            *bound = bound.min(self.region_bound(k, &sf, &loads));
             solved += 1;
             best = best.max(*bound);
             if bound.is_nan() || *bound > until {
@@ -1042,26 +1044,17 @@ impl Analyzer {
     /// The region bound at the corners of a triangle (or segment, or
     /// point) that holds the failing poses' coordinates (each mover's
     /// moment change along two unit axes across gravity;
-    /// [`pose_hull::enclosing_triangle`]): the largest, valid for every
+    /// [`pose_hull::enclosing`]): the largest, valid for every
     /// failing pose (see [`Analyzer::tighten`]), and the region analyses it
     /// took; `None` where the poses need as many corners as they are; NaN
     /// where a corner's bound is. Stops at the first corner above
     /// [`Settings::region_until`].
-    #[allow(clippy::too_many_arguments)]
     fn hull_bound(
         &self,
-        s: &Structure,
-        comps: &Components,
-        c: usize,
-        st: &Settled,
-        slot: &[usize],
-        poses: &Poses<'_>,
+        k: &Failing<'_>,
         failing: &[(Option<usize>, f64)],
     ) -> Option<(f64, usize)> {
-        let points: Vec<Vec<f64>> = failing
-            .iter()
-            .map(|(p, _)| (poses.coordinates)(*p))
-            .collect();
+        let points: Vec<Vec<f64>> = failing.iter().map(|(p, _)| (k.coordinates)(*p)).collect();
         let corners = pose_hull::enclosing(&points, points.len().saturating_sub(1))?;
         let mut bound = 0.0_f64;
         let mut solved = 0;
@@ -1072,10 +1065,10 @@ impl Analyzer {
             let (mut loads, mut sf) = (Vec::new(), Vec::new());
             for &(i, w) in corner {
                 let pose = failing[i].0;
-                add_scaled(&mut loads, &body_loads(s, pose), w);
-                add_scaled(&mut sf, &(poses.at)(pose), w);
+                add_scaled(&mut loads, &body_loads(k.s, pose), w);
+                add_scaled(&mut sf, &(k.at)(pose), w);
             }
-            let b = self.region_bound(s, comps, c, st, slot, &sf, &loads);
+            let b = self.region_bound(k, &sf, &loads);
             solved += 1;
             if b.is_nan() {
                 return Some((f64::NAN, solved));
@@ -1097,17 +1090,15 @@ impl Analyzer {
     /// scaling of its elastic action makes admissible (a ground contact
     /// pressed off-centre, bound ∞) is inside the region, so its bound
     /// need not be.
-    #[allow(clippy::too_many_arguments)]
-    fn region_bound(
-        &self,
-        s: &Structure,
-        comps: &Components,
-        c: usize,
-        st: &Settled,
-        slot: &[usize],
-        sf: &[Vec6],
-        loads: &[Vec6],
-    ) -> f64 {
+    fn region_bound(&self, k: &Failing<'_>, sf: &[Vec6], loads: &[Vec6]) -> f64 {
+        let Failing {
+            s,
+            comps,
+            c,
+            st,
+            slot,
+            ..
+        } = *k;
         let links = &comps.links[c];
         let bound: Vec<f64> = links
             .iter()
