@@ -1010,6 +1010,9 @@ impl Analyzer {
     /// poses; a pose left untightened is at most that), or one stays above
     /// `region_until`. Sorted again after; returns the region analyses.
     fn tighten(&self, k: &Failing<'_>, failing: &mut [(Option<usize>, f64)]) -> usize {
+        if failing.is_empty() {
+            return 0;
+        }
         let until = self.settings.region_until;
         let mut solved = 0;
         if let Some((bound, n)) = self.hull_bound(k, failing) {
