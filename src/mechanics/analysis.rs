@@ -120,8 +120,9 @@ pub struct Analysis {
     pub iterations: usize,
     pub factorizations: usize,
     /// Region limit analyses ([`Settings::region_hops`]) this analysis
-    /// took: one per failing pose, or one per corner of the triangle that
-    /// holds the failing poses' mover moments where that is fewer.
+    /// took: one per failing pose, or one per corner of the few that hold
+    /// the failing poses' mover moments where that is fewer
+    /// ([`pose_hull::enclosing`]).
     pub region_analyses: usize,
 }
 
@@ -152,8 +153,6 @@ struct Screen {
     sampled_only: bool,
 }
 
-/// The settled elastic equilibrium of one component (see
-/// [`Analyzer::settle`]).
 /// A failing component as [`Analyzer::tighten`] sees it: component `c`
 /// of `s`, its settled active set, each active link's slot in an
 /// interface-force vector, and per pose its elastic interface forces and
@@ -171,6 +170,8 @@ struct Failing<'a> {
     coordinates: &'a dyn Fn(Option<usize>) -> Vec<f64>,
 }
 
+/// The settled elastic equilibrium of one component (see
+/// [`Analyzer::settle`]).
 struct Settled {
     k: BlockMatrix,
     /// Displacements at the reference pose.
@@ -973,11 +974,14 @@ impl Analyzer {
                 }
                 sf
             };
+            // Each mover's reference moment, taken once (not per pose).
+            let references: Vec<DVec3> = movers.iter().map(|&h| mover_moment(s, h, None)).collect();
             let coordinates = |pose: Option<usize>| -> Vec<f64> {
                 movers
                     .iter()
-                    .flat_map(|&h| {
-                        let d = mover_moment(s, h, pose) - mover_moment(s, h, None);
+                    .zip(&references)
+                    .flat_map(|(&h, &reference)| {
+                        let d = mover_moment(s, h, pose) - reference;
                         [d.dot(e1), d.dot(e2)]
                     })
                     .collect()
@@ -998,8 +1002,8 @@ impl Analyzer {
 
     /// With the limit analysis off: the bounds of `1/λ` of the failing
     /// poses (worst first) tightened by [`Analyzer::region_bound`]. First,
-    /// where it takes fewer region analyses than the poses, at the corners
-    /// of a triangle that holds the failing poses' mover moments: each pose's
+    /// where it takes fewer region analyses than the poses, at the few
+    /// corners that hold the failing poses' mover moments: each pose's
     /// loads (and elastic field) are a convex combination of the corners',
     /// so the same combination of the corners' admissible fields, each
     /// scaled to the largest corner bound, carries the pose's loads scaled
@@ -1059,6 +1063,15 @@ impl Analyzer {
     ) -> Option<(f64, usize)> {
         let points: Vec<Vec<f64>> = failing.iter().map(|(p, _)| (k.coordinates)(*p)).collect();
         let corners = pose_hull::enclosing(&points, points.len().saturating_sub(1))?;
+        // The poses the corners combine (the same few for every corner):
+        // their loads and fields, each taken once.
+        let mut fields: Vec<Option<(Vec<Vec6>, Vec<Vec6>)>> = vec![None; failing.len()];
+        for &(i, _) in corners.iter().flatten() {
+            if fields[i].is_none() {
+                let pose = failing[i].0;
+                fields[i] = Some((body_loads(k.s, pose), (k.at)(pose)));
+            }
+        }
         let mut bound = 0.0_f64;
         let mut solved = 0;
         for corner in &corners {
@@ -1067,9 +1080,9 @@ impl Analyzer {
             // affine in the coordinates).
             let (mut loads, mut sf) = (Vec::new(), Vec::new());
             for &(i, w) in corner {
-                let pose = failing[i].0;
-                add_scaled(&mut loads, &body_loads(k.s, pose), w);
-                add_scaled(&mut sf, &(k.at)(pose), w);
+                let (pose_loads, pose_sf) = fields[i].as_ref().expect("taken above");
+                add_scaled(&mut loads, pose_loads, w);
+                add_scaled(&mut sf, pose_sf, w);
             }
             let b = self.region_bound(k, &sf, &loads);
             solved += 1;
