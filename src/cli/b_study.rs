@@ -60,6 +60,23 @@ pub struct Args {
     /// rank 0 judges the steps (its threads) when run under MPI.
     #[arg(long)]
     worst_only: bool,
+    /// As --worst-only, but a row proved to fail is judged no further: the
+    /// verdicts and the largest safe b are exact; a failing row's max util
+    /// (marked ≥) is a lower bound, and so are its pressures where a step
+    /// was left with no finite bound. For a large scaffold's b_max.
+    #[arg(long)]
+    until_verdict: bool,
+}
+
+impl Args {
+    fn judging(&self) -> b_study::Judging {
+        use b_study::Judging;
+        match (self.until_verdict, self.worst_only) {
+            (true, _) => Judging::UntilVerdict,
+            (false, true) => Judging::WorstOnly,
+            (false, false) => Judging::Every,
+        }
+    }
 }
 
 /// `--pressure` in kPa as the model's pressure in Pa: positive and finite
@@ -109,6 +126,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
     let lengths: Vec<usize> = (b_min..=b_max).collect();
     let progress = super::progress::reporter(!a.no_progress && parallel::is_root(), 1);
     let times = std::env::var_os("RECONFCHECK_RANGE_TIMES").is_some();
+    let judging = a.judging();
     // The ranges of steps of every b are one pool of jobs for this
     // process's threads, or for every process under MPI; rank 0 folds the
     // rows from every part and alone writes.
@@ -118,7 +136,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
         &generate,
         &progress,
         tolerance,
-        a.worst_only,
+        judging,
         &|order, job| {
             let timed = |t: usize| {
                 let clock = std::time::Instant::now();
@@ -144,7 +162,7 @@ pub fn run(a: Args) -> Result<u8, Error> {
             })
             .into());
     }
-    let st = b_study::assemble(&a.family, &m, rows, unplanned, tolerance, a.worst_only);
+    let st = b_study::assemble(&a.family, &m, rows, unplanned, tolerance, judging);
     print!("{}", st.table());
     #[cfg(feature = "render")]
     if let Some(p) = &a.plot {

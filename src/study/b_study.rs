@@ -61,6 +61,18 @@ pub struct Row {
     /// every step was judged.
     #[serde(default)]
     pub steps_bounded: usize,
+    /// Steps left with an infinite bound ([`Judging::UntilVerdict`]): no
+    /// equilibrium within capacity was shown there at any scale, so the
+    /// row's pressures are lower bounds (such a step might need more, or
+    /// lack an equilibrium) and the pressure sweep does not count the row
+    /// as holding. 0 when every step's bound was finite or judged.
+    #[serde(default)]
+    pub equilibria_unproved: usize,
+    /// Bounded steps taken up by [`prove_worst`] (a region's bound, and the
+    /// full limit analysis where that stays above the worst): where a
+    /// worst-only study's time went.
+    #[serde(default)]
+    pub steps_judged: usize,
 }
 
 impl Row {
@@ -117,10 +129,36 @@ pub struct Study {
     /// (0: exact). Which b are safe does not depend on it; a failing
     /// structure's utilisation `1/λ` may read up to this fraction low.
     pub load_factor_tolerance: f64,
-    /// Only the steps that could be a row's worst were limit-analysed
-    /// ([`study_rows`]' `worst_only`).
-    #[serde(default)]
-    pub worst_only: bool,
+    /// Which steps were limit-analysed ([`Judging`]).
+    pub judging: Judging,
+}
+
+/// Which steps a study limit-analyses (the elastic screen sees every step).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Judging {
+    /// Every step the elastic screen cannot clear, in its range.
+    Every,
+    /// Only the steps that could be a row's worst ([`prove_worst`]): the
+    /// rows are those of judging every step.
+    WorstOnly,
+    /// As [`Judging::WorstOnly`], but a row proved to fail (a step judged
+    /// above utilisation 1, or without an equilibrium) is judged no
+    /// further: its verdict is decided, and its maximum is then marked
+    /// `max_utilisation_at_least` where a step left bounded could exceed
+    /// it. Safe rows, and so `b_max`, are exactly those of judging every
+    /// step; what a failing row's table says beyond its verdict is a lower
+    /// bound. For a study whose question is the largest safe b of a large
+    /// scaffold, where judging every candidate step of the failing b costs
+    /// hours.
+    UntilVerdict,
+}
+
+impl Judging {
+    /// The ranges run with the limit analysis off; [`prove_worst`] judges.
+    fn bounds_only(self) -> bool {
+        self != Judging::Every
+    }
 }
 
 /// The closed form in the branch family's terms: growing a branch of `b`
@@ -247,13 +285,27 @@ pub fn b_study(
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
 ) -> Result<Study, InputError> {
-    let (rows, unplanned, first_error) =
-        study_rows(model, lengths, generate, progress, 0.0, false, &on_threads)?
-            .expect("this process's threads fold the rows");
+    let (rows, unplanned, first_error) = study_rows(
+        model,
+        lengths,
+        generate,
+        progress,
+        0.0,
+        Judging::Every,
+        &on_threads,
+    )?
+    .expect("this process's threads fold the rows");
     if let (true, Some(e)) = (rows.is_empty(), first_error) {
         return Err(e);
     }
-    Ok(assemble(family, model, rows, unplanned, 0.0, false))
+    Ok(assemble(
+        family,
+        model,
+        rows,
+        unplanned,
+        0.0,
+        Judging::Every,
+    ))
 }
 
 /// What the study keeps of one step's analysis (sent between processes
@@ -357,21 +409,22 @@ pub fn on_threads(
 /// the rows do not depend on who ran what. `None` where `runner` returns
 /// none (a process that does not fold).
 ///
-/// `worst_only`: a row needs the exact utilisation of its worst step, not
-/// of every step. The ranges then run with the limit analysis off, so a
-/// step the elastic screen cannot clear gets an upper bound of its
-/// utilisation (`Settings::limit_analysis`); [`prove_worst`] then judges
-/// steps from the highest bound down, until no bound left exceeds the
-/// worst utilisation proved. The rows' verdicts, maxima and pressures are
-/// those of judging every step; `limit_analyses` and `steps_bounded`
-/// say what was spared.
+/// [`Judging::WorstOnly`]: a row needs the exact utilisation of its worst
+/// step, not of every step. The ranges then run with the limit analysis
+/// off, so a step the elastic screen cannot clear gets an upper bound of
+/// its utilisation (`Settings::limit_analysis`); [`prove_worst`] then
+/// judges steps from the highest bound down, until no bound left exceeds
+/// the worst utilisation proved. The rows' verdicts, maxima and pressures
+/// are those of judging every step; `limit_analyses` and `steps_bounded`
+/// say what was spared. [`Judging::UntilVerdict`] stops judging a row
+/// once it is proved to fail.
 pub fn study_rows(
     model: &Model,
     lengths: &[usize],
     generate: impl Fn(usize) -> Result<Schedule, InputError>,
     progress: &Reporter,
     load_factor_tolerance: f64,
-    worst_only: bool,
+    judging: Judging,
     runner: Runner<'_>,
 ) -> Result<Option<StudyRows>, InputError> {
     let mut planned = Vec::new();
@@ -394,7 +447,7 @@ pub fn study_rows(
         let m = model.at_spacing_checked(schedule.spacing.metres())?;
         let range = crate::certify::default_range_steps(schedule.steps.len());
         let mut replay = RangedReplay::new(schedule, &m, load_factor_tolerance, range)?;
-        if worst_only {
+        if judging.bounds_only() {
             replay = replay.bounds_only();
         }
         let hinge = Capacity {
@@ -452,13 +505,26 @@ pub fn study_rows(
         .iter()
         .map(|(_, replay, _, _)| found.by_ref().take(replay.jobs()).flatten().collect())
         .collect();
-    if worst_only {
-        prove_worst(&studied, &mut per_b, progress)?;
-    }
+    let judged = if judging.bounds_only() {
+        prove_worst(&studied, &mut per_b, judging, progress)?
+    } else {
+        vec![0; per_b.len()]
+    };
     let mut rows = Vec::new();
-    for ((mut row, _, _, _), findings) in studied.into_iter().zip(per_b) {
+    for (((mut row, _, _, _), findings), judged) in studied.into_iter().zip(per_b).zip(judged) {
+        row.steps_judged = judged;
+        // The highest bound left unjudged: above the worst proved only
+        // where judging stopped at the verdict.
+        let mut left = 0.0f64;
         for f in findings {
+            if f.bounded {
+                left = left.max(f.max_utilisation);
+                row.equilibria_unproved += usize::from(f.max_utilisation == f64::INFINITY);
+            }
             row.fold(f);
+        }
+        if left > row.max_utilisation {
+            row.max_utilisation_at_least = true;
         }
         if row.no_equilibrium {
             row.min_pressure_rigid_hinge = f64::INFINITY;
@@ -483,11 +549,16 @@ const PROVED_TOGETHER: usize = 4;
 /// ([`RangedReplay::bound_step`], [`REGION_HOPS`] links around the
 /// overloaded ones, stopping at the first pose above the row's worst):
 /// only a step still above the worst is judged in full.
+/// [`Judging::UntilVerdict`]: a row whose worst proved exceeds 1 (or has
+/// no equilibrium) is decided, and none of its steps is judged further.
+/// Returns how many steps of each row were judged.
 fn prove_worst(
     studied: &[(Row, RangedReplay<'_>, Capacity, Capacity)],
     per_b: &mut [Vec<StepFinding>],
+    judging: Judging,
     progress: &Reporter,
-) -> Result<(), InputError> {
+) -> Result<Vec<usize>, InputError> {
+    let mut judged = vec![0; per_b.len()];
     let proved_max = |findings: &[StepFinding]| {
         findings
             .iter()
@@ -524,11 +595,13 @@ fn prove_worst(
         "bounded steps judged, highest bound first (until none left can raise its row's worst)",
         candidates.len() as u64,
     );
+    let decided =
+        |w: f64| judging == Judging::UntilVerdict && crate::mechanics::capacity::overloaded(w);
     let mut next = candidates.into_iter();
     loop {
         let batch: Vec<(usize, usize)> = next
             .by_ref()
-            .filter(|&(r, i)| per_b[r][i].max_utilisation > worst[r])
+            .filter(|&(r, i)| per_b[r][i].max_utilisation > worst[r] && !decided(worst[r]))
             .take(PROVED_TOGETHER)
             .collect();
         if batch.is_empty() {
@@ -556,6 +629,7 @@ fn prove_worst(
         };
         let done = jobs::in_order(jobs::on_threads(&order, &job), batch.len())?;
         for ((r, i), mut f) in batch.into_iter().zip(done) {
+            judged[r] += 1;
             worst[r] = worst[r].max(f.max_utilisation);
             // The pressures come from the elastic loads: keep those of the
             // ranges (a step analysed from scratch differs by round-off).
@@ -566,7 +640,7 @@ fn prove_worst(
         }
     }
     progress.finish();
-    Ok(())
+    Ok(judged)
 }
 
 /// A row before any step is folded in: the closed forms of `b − 1`
@@ -596,6 +670,8 @@ fn empty_row(b: usize, steps: usize, m: &Model) -> Row {
         ),
         limit_analyses: 0,
         steps_bounded: 0,
+        equilibria_unproved: 0,
+        steps_judged: 0,
     }
 }
 
@@ -630,7 +706,7 @@ pub fn assemble(
     mut rows: Vec<Row>,
     mut unplanned: Vec<Unplanned>,
     load_factor_tolerance: f64,
-    worst_only: bool,
+    judging: Judging,
 ) -> Study {
     rows.sort_by_key(|r| r.b);
     unplanned.sort_by_key(|u| u.b);
@@ -655,9 +731,11 @@ pub fn assemble(
             SweepRow {
                 pressure_kpa: kpa,
                 b_max_rigid_hinge: prefix_max(&|r: &Row| {
-                    r.min_pressure_rigid_hinge <= p * (1.0 + 1e-9)
+                    r.equilibria_unproved == 0 && r.min_pressure_rigid_hinge <= p * (1.0 + 1e-9)
                 }),
-                b_max_elastic: prefix_max(&|r: &Row| r.min_pressure_elastic <= p * (1.0 + 1e-9)),
+                b_max_elastic: prefix_max(&|r: &Row| {
+                    r.equilibria_unproved == 0 && r.min_pressure_elastic <= p * (1.0 + 1e-9)
+                }),
                 closed_rigid_hinge: closed_branch_max(
                     &model.with_connector(p, Bending::RigidHinge),
                 ),
@@ -676,7 +754,7 @@ pub fn assemble(
         closed_b_max: closed_branch_max(model),
         sweep,
         load_factor_tolerance,
-        worst_only,
+        judging,
     }
 }
 
@@ -714,15 +792,38 @@ impl Study {
                 self.load_factor_tolerance
             );
         }
-        if self.worst_only {
+        if self.judging == Judging::UntilVerdict {
+            let _ = writeln!(
+                s,
+                "until the verdict: a failing row was judged no further than a step proved to fail; its max util (≥) and its pressures where steps were left unproved (≥) are lower bounds"
+            );
+        }
+        if self.judging.bounds_only() {
             let bounded: Vec<String> = self
                 .rows
                 .iter()
-                .map(|r| format!("b = {}: {} of {}", r.b, r.steps_bounded, r.steps + 1))
+                .map(|r| {
+                    let unproved = match r.equilibria_unproved {
+                        0 => String::new(),
+                        n => format!(" ({n} with no finite bound)"),
+                    };
+                    format!(
+                        "b = {}: {} of {}{unproved}, {} judged",
+                        r.b,
+                        r.steps_bounded,
+                        r.steps + 1,
+                        r.steps_judged
+                    )
+                })
                 .collect();
             let _ = writeln!(
                 s,
-                "worst only: steps bounded, not limit-analysed (they cannot raise the worst): {}",
+                "worst only: steps bounded, not limit-analysed{}: {}",
+                if self.judging == Judging::WorstOnly {
+                    " (they cannot raise the worst)"
+                } else {
+                    ""
+                },
                 bounded.join(", ")
             );
         }
@@ -740,9 +841,15 @@ impl Study {
             "closed EL"
         );
         for r in &self.rows {
+            // In kPa; "≥" where a step left with an infinite bound could
+            // need more.
+            let pressure = |pa: f64| {
+                let at_least = if r.equilibria_unproved > 0 { "≥" } else { "" };
+                format!("{at_least}{:.2}", pa / 1e3)
+            };
             let _ = writeln!(
                 s,
-                "{:>4} {:>6} {:>9} {:>9.4} {:>6} {:>10.2} {:>10.2} {:>10.2} {:>10.2}  step {}: {}",
+                "{:>4} {:>6} {:>9} {:>9.4} {:>6} {:>10} {:>10} {:>10.2} {:>10.2}  step {}: {}",
                 r.b,
                 r.steps,
                 format!(
@@ -756,8 +863,8 @@ impl Study {
                 ),
                 r.closed_utilisation,
                 if r.safe() { "yes" } else { "NO" },
-                r.min_pressure_rigid_hinge / 1e3,
-                r.min_pressure_elastic / 1e3,
+                pressure(r.min_pressure_rigid_hinge),
+                pressure(r.min_pressure_elastic),
                 r.closed_pressure_rigid_hinge / 1e3,
                 r.closed_pressure_elastic / 1e3,
                 r.critical_step,
@@ -873,14 +980,22 @@ mod tests {
             st.rows[..5].to_vec(),
             Vec::new(),
             0.0,
-            false,
+            Judging::Every,
         );
         assert_eq!(
             holding.replayed_b(),
             Some((5, "the largest b studied; every b holds"))
         );
         assert_eq!(
-            assemble("branch", &model, Vec::new(), Vec::new(), 0.0, false).replayed_b(),
+            assemble(
+                "branch",
+                &model,
+                Vec::new(),
+                Vec::new(),
+                0.0,
+                Judging::Every
+            )
+            .replayed_b(),
             None
         );
         // The summary's closed form counts the same weights as the family's
@@ -1019,7 +1134,7 @@ mod tests {
                 generate,
                 &Reporter::silent(),
                 0.0,
-                false,
+                Judging::Every,
                 runner,
             )
             .unwrap()
@@ -1060,7 +1175,7 @@ mod tests {
                 generate,
                 &Reporter::silent(),
                 0.0,
-                false,
+                Judging::Every,
                 &lossy
             )
             .is_err()
@@ -1068,7 +1183,8 @@ mod tests {
     }
 
     #[test]
-    fn judging_only_the_steps_that_could_be_the_worst_gives_the_rows_of_judging_every_step() {
+    fn judging_only_the_worst_steps_or_until_the_verdict_keeps_the_verdicts_of_judging_every_step()
+    {
         // Pyramids at 30 kPa: b = 4 holds, b = 6 and 9 fail (the screen
         // fails: 7 and 92 limit analyses prove 1/λ =
         // 1.156 and 3.469). Worst-only must find the same verdicts, maxima (to the
@@ -1077,9 +1193,13 @@ mod tests {
         // is proved to the solver's tolerance, 1e-8 of itself, and a step
         // analysed alone starts the solver at another regularisation than
         // one analysed after its range's earlier steps: b = 9's maximum
-        // differs by 6.5e-9 of itself.)
+        // differs by 6.5e-9 of itself.) Until the verdict, the failing rows
+        // stop at their first step proved to fail: the same verdicts and
+        // pressures, the holding row as worst-only's, a failing row's
+        // maximum a lower bound (marked where it is below the true one),
+        // fewer limit analyses still.
         let model = Model::default_catom().with_connector(30e3, Bending::RigidHinge);
-        let rows = |worst_only: bool| {
+        let rows = |judging: Judging| {
             let generate = family("pyramid", 3.6, Some(2), None).unwrap();
             let (rows, _, _) = study_rows(
                 &model,
@@ -1087,14 +1207,18 @@ mod tests {
                 generate,
                 &Reporter::silent(),
                 0.0,
-                worst_only,
+                judging,
                 &on_threads,
             )
             .unwrap()
             .expect("this process folds");
             rows
         };
-        let (every, worst) = (rows(false), rows(true));
+        let (every, worst, verdict) = (
+            rows(Judging::Every),
+            rows(Judging::WorstOnly),
+            rows(Judging::UntilVerdict),
+        );
         assert_eq!(every.len(), 3);
         let mut spared = 0;
         for (e, w) in every.iter().zip(&worst) {
@@ -1117,6 +1241,70 @@ mod tests {
         }
         assert!(spared > 0, "no step was left bounded: {worst:?}");
         assert!(every.iter().any(|r| !r.safe()) && every.iter().any(|r| r.limit_analyses > 0));
+        let (mut solved, mut solved_worst, mut judged, mut judged_worst) = (0, 0, 0, 0);
+        for ((e, w), v) in every.iter().zip(&worst).zip(&verdict) {
+            let what = format!("b = {}: {e:?}\n{v:?}", e.b);
+            assert_eq!(e.safe(), v.safe(), "{what}");
+            assert_eq!(e.min_pressure_rigid_hinge, v.min_pressure_rigid_hinge);
+            assert_eq!(e.min_pressure_elastic, v.min_pressure_elastic);
+            if e.safe() {
+                assert_eq!(format!("{w:?}"), format!("{v:?}"));
+            } else {
+                assert!(v.max_utilisation > 1.0, "{what}");
+                assert!(
+                    v.max_utilisation <= e.max_utilisation * (1.0 + 1e-7),
+                    "{what}"
+                );
+                if v.max_utilisation < e.max_utilisation * (1.0 - 1e-7) {
+                    assert!(v.max_utilisation_at_least, "{what}");
+                }
+            }
+            solved += v.limit_analyses;
+            solved_worst += w.limit_analyses;
+            judged += v.steps_judged;
+            judged_worst += w.steps_judged;
+        }
+        assert!(solved <= solved_worst, "{solved} vs {solved_worst}");
+        assert!(judged < judged_worst, "{judged} vs {judged_worst}");
+        // b = 9 stops with steps whose bound is infinite (79): its
+        // pressures are then only lower bounds (the sweep's test below).
+        assert!(verdict.iter().any(|r| r.equilibria_unproved > 0));
+        assert!(
+            verdict
+                .iter()
+                .all(|r| r.equilibria_unproved == 0 || !r.safe())
+        );
+    }
+
+    #[test]
+    fn a_row_with_a_step_left_without_a_finite_bound_holds_at_no_pressure_of_the_sweep() {
+        // Its pressures come from the elastic loads of steps whose
+        // equilibrium was shown; a step left with an infinite bound might
+        // need more, so the sweep must not count the row as holding.
+        let m = Model::default_catom();
+        let mut row = empty_row(4, 10, &m);
+        row.max_utilisation = 0.5;
+        row.min_pressure_rigid_hinge = 1e3;
+        row.min_pressure_elastic = 1e3;
+        let b_max_at_150 = |row: &Row| {
+            let st = assemble(
+                "t",
+                &m,
+                vec![row.clone()],
+                vec![],
+                0.0,
+                Judging::UntilVerdict,
+            );
+            let w = st.sweep.iter().find(|w| w.pressure_kpa == 150.0).unwrap();
+            (st.b_max, w.b_max_rigid_hinge, w.b_max_elastic, st.table())
+        };
+        let (b, rh, el, table) = b_max_at_150(&row);
+        assert_eq!((b, rh, el), (4, 4, 4));
+        assert!(!table.contains("≥1.00"), "{table}");
+        row.equilibria_unproved = 1;
+        let (_, rh, el, table) = b_max_at_150(&row);
+        assert_eq!((rh, el), (0, 0));
+        assert!(table.contains("≥1.00"), "{table}");
     }
 
     #[test]

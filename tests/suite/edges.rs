@@ -444,7 +444,7 @@ fn a_load_factor_tolerance_reports_a_proven_lower_bound_of_each_judged_factor() 
 fn the_b_study_spares_limit_analyses_within_its_tolerance_and_keeps_its_verdicts() {
     use reconfcheck::mechanics::Model;
     use reconfcheck::progress::Reporter;
-    use reconfcheck::study::b_study::{assemble, on_threads, study_rows};
+    use reconfcheck::study::b_study::{Judging, assemble, on_threads, study_rows};
     let model =
         Model::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"))
             .unwrap();
@@ -455,12 +455,19 @@ fn the_b_study_spares_limit_analyses_within_its_tolerance_and_keeps_its_verdicts
             |_| Ok(plastic_cantilever()),
             &Reporter::silent(),
             tolerance,
-            false,
+            Judging::Every,
             &on_threads,
         )
         .unwrap()
         .expect("threads fold the rows");
-        assemble("cantilever", &model, rows, unplanned, tolerance, false)
+        assemble(
+            "cantilever",
+            &model,
+            rows,
+            unplanned,
+            tolerance,
+            Judging::Every,
+        )
     };
     let (exact, spared) = (study(0.0), study(0.05));
     let (e, t) = (&exact.rows[0], &spared.rows[0]);
