@@ -9,7 +9,8 @@
 //! modulus and layer thickness cancel out of the loads). Results are in SI.
 
 use super::capacity::{
-    CORNER_FREE_BELOW, ConnectorLoad, Mode, corner_ratio, overloaded, severity, utilisation,
+    CORNER_FREE_BELOW, ConnectorLoad, Mode, corner_ratio, overloaded, scale_within, severity,
+    utilisation,
 };
 use super::direct::Factor;
 use super::limit::{self, Connectors};
@@ -89,15 +90,17 @@ pub struct Analysis {
     /// The smallest load factor `λ` of the components the elastic screen
     /// could not clear (`None`: the screen cleared every one).
     pub load_factor: Option<f64>,
-    /// Some component had failed at a pose already, and a pose with no
-    /// bound on its factor was left unanalysed: the true smallest factor
-    /// may be lower than `load_factor` (the verdict stands).
+    /// Some component had failed at a pose already, and a pose whose bound
+    /// exceeds the worst found was left unanalysed: the true smallest
+    /// factor may be lower than `load_factor`, down to
+    /// `load_factor_lower` (the verdict stands).
     pub load_factor_partial: bool,
-    /// With a load-factor tolerance: a proven lower bound of the exact
-    /// smallest factor (the smallest of the factors solved and of the
-    /// bounds that spared the other poses), so the exact one lies in
-    /// `[load_factor_lower, load_factor]`; 0 where a pose was left out
-    /// with no bound. `None` when exact or when no limit analysis ran.
+    /// With a load-factor tolerance, or `load_factor_partial`: a proven
+    /// lower bound of the exact smallest factor (the smallest of the
+    /// factors solved and of the bounds of the poses spared or left out),
+    /// so the exact one lies in `[load_factor_lower, load_factor]`; 0
+    /// where a pose was left out with no bound. `None` when exact or when
+    /// no limit analysis ran.
     pub load_factor_lower: Option<f64>,
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
@@ -1429,21 +1432,26 @@ impl Analyzer {
         }
         if self.settings.corner_gate && overloaded(r) {
             j_out.gate = r;
-            // First scale by `k₀ = max(u, 1)`, which brings the load
-            // within the utilisation (centre of pressure inside the
-            // square); from there the forces scaled down by `k` keep
-            // the centre no further out and the clamp at `pL² − N/k`,
-            // so the corners carry them from `k = r − (r − 1)·N/pL²`
-            // (never for a contact without adhesion, where scaling
-            // changes no ratio).
-            let k0 = u.max(1.0);
+            // First scale by the `k₀` that brings the load within the
+            // utilisation (centre of pressure inside the square): both
+            // modes' demands `D` scale with the load, the clamp
+            // `pL² + compression` only in its compression, so
+            // `(D/k)/(pL² + N_c/k) = 1` at `k₀ = u + (u − 1)·N_c/pL²`
+            // (`u` itself only for a link in tension: scaling a
+            // compressed link by `1/u` leaves it above 1, its clamp
+            // shrinking too). From there the forces scaled down by `k`
+            // keep the centre no further out and the clamp at
+            // `pL² − N/k`, so the corners carry them from
+            // `k = r − (r − 1)·N/pL²` (never for a contact without
+            // adhesion, where scaling changes no ratio).
+            let p = cap.tension();
+            let k0 = scale_within(&load, cap);
             let scaled = load.scaled(1.0 / k0);
             let r0 = if k0 > 1.0 {
                 severity(corner_ratio(&scaled, cap))
             } else {
                 r
             };
-            let p = cap.tension();
             j_out.scale = if !overloaded(r0) {
                 k0
             } else if p > 0.0 {
@@ -1595,19 +1603,21 @@ impl Analyzer {
                 break;
             }
             if failed {
-                // The step fails already. A pose with a bound is counted at
-                // it: the factor stays a lower bound of the true smallest.
-                // A pose with none (its elastic field no scaling makes
-                // admissible) is left out, at 25 poses a sweep the cost of
-                // a whole analysis per failing step: the factor is then
-                // only the smallest found (`partial`).
-                if bound.is_finite() {
-                    out.capacities = lowest(out.capacities, 1.0 / bound);
-                    out.lower = lowest(out.lower, 1.0 / bound);
+                // The step fails already, and this pose's bound exceeds the
+                // worst found (the loop stops at the first that does not).
+                // It is left out, at 25 poses a sweep the cost of a whole
+                // analysis per failing step: the factor is the smallest
+                // found, the true smallest may be lower (`partial`), and
+                // no lower than the bound (`lower`). (Counting the pose at
+                // its bound instead would report the bound, an elastic
+                // scaling that can be several times the true 1/λ, as if it
+                // were the factor.)
+                out.partial = true;
+                out.lower = if bound.is_finite() {
+                    lowest(out.lower, 1.0 / bound)
                 } else {
-                    out.partial = true;
-                    out.lower = 0.0;
-                }
+                    0.0
+                };
                 continue;
             }
             if let Some(b) = self.spared_by(s, part, &fields, pose, out.capacities) {
@@ -1831,11 +1841,8 @@ impl Analyzer {
             let lf = l.capacities;
             out.load_factor = Some(out.load_factor.map_or(lf, |x| lowest(x, lf)));
             out.load_factor_partial |= l.partial;
-            if self.settings.load_factor_tolerance > 0.0 {
-                let lower = lowest(l.lower, l.capacities);
-                out.load_factor_lower =
-                    Some(out.load_factor_lower.map_or(lower, |x| lowest(x, lower)));
-            }
+            let lower = lowest(l.lower, l.capacities);
+            out.load_factor_lower = Some(out.load_factor_lower.map_or(lower, |x| lowest(x, lower)));
             if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.
@@ -1862,6 +1869,10 @@ impl Analyzer {
             if overloaded(1.0 / l.capacities) {
                 any_overloaded = true;
             }
+        }
+        // A lower end only where the factor may not be exact.
+        if self.settings.load_factor_tolerance == 0.0 && !out.load_factor_partial {
+            out.load_factor_lower = None;
         }
         out.max_utilisation = max;
         out.hold_utilisation = hold_max;

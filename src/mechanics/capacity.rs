@@ -103,6 +103,18 @@ impl ConnectorLoad {
 
 /// Utilisation (load / capacity, failure at 1) and its governing mode.
 pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
+    // A NaN component would vanish in the `max` below and read as
+    // unloaded: NaN instead, which `overloaded` counts as over.
+    let parts = [
+        load.axial,
+        load.shear,
+        load.torsion,
+        load.moment_u,
+        load.moment_v,
+    ];
+    if parts.iter().any(|x| x.is_nan()) {
+        return (f64::NAN, Mode::Bending);
+    }
     let l = cap.side;
     let tension = load.axial.max(0.0);
     let compression = (-load.axial).max(0.0);
@@ -130,6 +142,28 @@ pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
     } else {
         (f, Mode::Friction)
     }
+}
+
+/// The smallest `k ≥ 1` such that `load / k` is within the utilisation
+/// (≤ 1); ∞ where none is (a contact without adhesion loaded beyond it:
+/// scaling changes no ratio), NaN for a NaN load. Both modes' demands `D`
+/// scale with the load and the clamp `pL² + N_c` only in its compression,
+/// so `(D/k)/(pL² + N_c/k) = 1` at `k = u + (u − 1)·N_c/pL²`: `u` itself
+/// only for a link in tension (a compressed link scaled by `1/u` is still
+/// above 1, its clamp having shrunk too).
+pub fn scale_within(load: &ConnectorLoad, cap: &Capacity) -> f64 {
+    let (u, _) = utilisation(load, cap);
+    if u.is_nan() || u <= 1.0 {
+        return if u.is_nan() { f64::NAN } else { 1.0 };
+    }
+    let p = cap.tension();
+    if p.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return f64::INFINITY;
+    }
+    let compression = (-load.axial).max(0.0);
+    // A hair above: at `k` itself the centre of pressure lies on the
+    // square's edge, where rounding could put it just beyond.
+    (u + (u - 1.0) * compression / p) * (1.0 + 1e-12)
 }
 
 /// Below this utilisation the corner construction always carries a load
@@ -241,6 +275,100 @@ mod tests {
             side: 1e-3,
             friction: 0.5,
             bending,
+        }
+    }
+
+    #[test]
+    fn a_load_scaled_by_scale_within_is_just_within_the_utilisation_and_inside_the_square() {
+        // Against bisection on the utilisation itself, over a grid of
+        // loads in tension and in compression (where scaling by 1/u is not
+        // enough: the clamp shrinks with the compression), both bending
+        // criteria.
+        let mut checked = 0;
+        for bending in [Bending::Elastic, Bending::RigidHinge] {
+            let c = cap(bending);
+            let t = c.tension();
+            let m = t * c.side;
+            for axial in [-20.0 * t, -3.0 * t, -0.5 * t, 0.0, 0.4 * t, 2.0 * t] {
+                for (mu, mv) in [
+                    (0.0, 0.0),
+                    (2.0 * m, 0.0),
+                    (0.7 * m, 5.0 * m),
+                    (30.0 * m, 1.0 * m),
+                ] {
+                    for (shear, torsion) in [(0.0, 0.0), (3.0 * t, 0.0), (0.2 * t, 4.0 * m)] {
+                        let load = ConnectorLoad {
+                            axial,
+                            shear,
+                            torsion,
+                            moment_u: mu,
+                            moment_v: mv,
+                        };
+                        let k = scale_within(&load, &c);
+                        let u = |k: f64| utilisation(&load.scaled(1.0 / k), &c).0;
+                        let what = format!("{load:?} {bending:?}: k {k}");
+                        assert!(k.is_finite() && k >= 1.0, "{what}");
+                        assert!(u(k) <= 1.0, "{what}: {}", u(k));
+                        if u(1.0) > 1.0 {
+                            // The smallest such k, by bisection.
+                            let (mut lo, mut hi) = (1.0, 2.0);
+                            while u(hi) > 1.0 {
+                                hi *= 2.0;
+                            }
+                            for _ in 0..200 {
+                                let mid = 0.5 * (lo + hi);
+                                if u(mid) > 1.0 { lo = mid } else { hi = mid }
+                            }
+                            assert!((k - hi).abs() <= 1e-9 * hi, "{what}: bisection {hi}");
+                            assert!(
+                                corner_ratio(&load.scaled(1.0 / k), &c).is_finite(),
+                                "{what}"
+                            );
+                            checked += 1;
+                        } else {
+                            assert_eq!(k, 1.0, "{what}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{checked}");
+        // Without adhesion no scaling helps; a NaN load has no scale.
+        let bare = Capacity {
+            pressure: 0.0,
+            ..cap(Bending::RigidHinge)
+        };
+        let tipped = ConnectorLoad {
+            axial: -1.0,
+            moment_u: 1.0,
+            ..Default::default()
+        };
+        assert_eq!(scale_within(&tipped, &bare), f64::INFINITY);
+        let nan = ConnectorLoad {
+            axial: f64::NAN,
+            ..tipped
+        };
+        assert!(scale_within(&nan, &cap(Bending::Elastic)).is_nan());
+    }
+
+    #[test]
+    fn a_load_with_a_nan_component_is_never_within_capacity() {
+        // `f64::max` drops a NaN: an axial force of NaN once read as no
+        // tension and no compression, so an otherwise unloaded connector
+        // passed.
+        let c = cap(Bending::Elastic);
+        for i in 0..5 {
+            let mut parts = [0.0; 5];
+            parts[i] = f64::NAN;
+            let load = ConnectorLoad {
+                axial: parts[0],
+                shear: parts[1],
+                torsion: parts[2],
+                moment_u: parts[3],
+                moment_v: parts[4],
+            };
+            let (u, _) = utilisation(&load, &c);
+            assert!(overloaded(u), "{load:?}: {u}");
         }
     }
 

@@ -1052,12 +1052,10 @@ mod tests {
 
     #[test]
     fn an_overloaded_pyramid_reports_its_load_factor_not_an_unbounded_utilisation() {
-        // At b = 10 the 2-pyramid is overloaded, and some failing poses have
-        // elastic fields the limit analysis's corners cannot carry at any
-        // scaling (no finite bound on 1/λ): those are analysed, not counted
-        // as unbounded. The worst step is a determinate ground-layer
-        // branch: 1/λ equals the closed form of b − 3 = 7 modules and the
-        // agent (as for every b ≥ 5 of this family).
+        // At b = 10 the 2-pyramid is overloaded. The worst step is a
+        // determinate ground-layer branch: 1/λ equals the closed form of
+        // b − 3 = 7 modules and the agent (as for every b ≥ 5 of this
+        // family).
         let model = Model::default_catom();
         let generate = family("pyramid", 3.6, None, None).unwrap();
         let st = b_study("pyramid", &model, &[10], generate, &Reporter::silent()).unwrap();
@@ -1069,10 +1067,32 @@ mod tests {
             r.max_utilisation
         );
         assert!(!r.safe());
-        // Poses with no bound were left out after the step failed: the
-        // row says its figure is a lower bound, and the table marks it.
+        // Poses whose bound exceeds the worst found were left out after
+        // the step failed: the row says its figure is a lower bound, and
+        // the table marks it.
         assert!(r.max_utilisation_at_least);
         assert!(st.table().contains("≥"), "{}", st.table());
+        // A step that left poses out: its factor is the smallest solved,
+        // and the bounds of the poses left out give a proven lower end.
+        let schedule = family("pyramid", 3.6, None, None).unwrap()(10).unwrap();
+        let m = model.at_spacing_checked(schedule.spacing.metres()).unwrap();
+        let replay = RangedReplay::new(&schedule, &m, 0.0, 16).unwrap();
+        let mut partial = Vec::new();
+        for j in 0..replay.jobs() {
+            let found = replay
+                .run(
+                    j,
+                    &|_, _, a, _| (a.load_factor_partial, a.load_factor, a.load_factor_lower),
+                    &|| {},
+                )
+                .unwrap();
+            partial.extend(found.into_iter().filter(|f| f.0));
+        }
+        assert!(!partial.is_empty());
+        for (_, factor, lower) in partial {
+            let (factor, lower) = (factor.unwrap(), lower.expect("a lower end where partial"));
+            assert!(lower > 0.0 && lower < factor, "{lower} vs {factor}");
+        }
     }
 
     #[test]
@@ -1197,7 +1217,7 @@ mod tests {
         // stop at their first step proved to fail: the same verdicts and
         // pressures, the holding row as worst-only's, a failing row's
         // maximum a lower bound (marked where it is below the true one),
-        // fewer limit analyses still.
+        // fewer steps judged where a failing row would go on.
         let model = Model::default_catom().with_connector(30e3, Bending::RigidHinge);
         let rows = |judging: Judging| {
             let generate = family("pyramid", 3.6, Some(2), None).unwrap();
@@ -1225,11 +1245,15 @@ mod tests {
             let what = format!("b = {}: {e:?}\n{w:?}", e.b);
             assert_eq!(e.safe(), w.safe(), "{what}");
             assert_eq!(e.no_equilibrium, w.no_equilibrium, "{what}");
+            // The maxima agree to the solver's accuracy; the critical
+            // step may be either of two mirror-image steps of one load
+            // case, which worst-only need not both judge (b = 6: steps 23
+            // and 45, 1/λ equal to 2e-9; b = 9: steps 39 and 77, to
+            // 1.5e-7).
             assert!(
-                (e.max_utilisation - w.max_utilisation).abs() <= 1e-7 * e.max_utilisation,
+                (e.max_utilisation - w.max_utilisation).abs() <= 1e-6 * e.max_utilisation,
                 "{what}"
             );
-            assert_eq!(e.critical_step, w.critical_step, "{what}");
             assert_eq!(
                 e.min_pressure_rigid_hinge, w.min_pressure_rigid_hinge,
                 "{what}"
@@ -1252,10 +1276,10 @@ mod tests {
             } else {
                 assert!(v.max_utilisation > 1.0, "{what}");
                 assert!(
-                    v.max_utilisation <= e.max_utilisation * (1.0 + 1e-7),
+                    v.max_utilisation <= e.max_utilisation * (1.0 + 1e-6),
                     "{what}"
                 );
-                if v.max_utilisation < e.max_utilisation * (1.0 - 1e-7) {
+                if v.max_utilisation < e.max_utilisation * (1.0 - 1e-6) {
                     assert!(v.max_utilisation_at_least, "{what}");
                 }
             }
@@ -1265,15 +1289,34 @@ mod tests {
             judged_worst += w.steps_judged;
         }
         assert!(solved <= solved_worst, "{solved} vs {solved_worst}");
-        assert!(judged < judged_worst, "{judged} vs {judged_worst}");
-        // b = 9 stops with steps whose bound is infinite (79): its
-        // pressures are then only lower bounds (the sweep's test below).
-        assert!(verdict.iter().any(|r| r.equilibria_unproved > 0));
-        assert!(
-            verdict
-                .iter()
-                .all(|r| r.equilibria_unproved == 0 || !r.safe())
-        );
+        assert!(judged <= judged_worst, "{judged} vs {judged_worst}");
+        // Every step's bound here is finite: the pressures are proved.
+        assert!(verdict.iter().all(|r| r.equilibria_unproved == 0));
+        // At 5 kPa b = 4 and 5 fail too, and worst-only goes on judging
+        // after their first failing step (12 steps each); until the
+        // verdict, one batch of 4 decides each.
+        let weak = Model::default_catom().with_connector(5e3, Bending::RigidHinge);
+        let rows = |judging: Judging| {
+            let generate = family("pyramid", 3.6, Some(2), None).unwrap();
+            study_rows(
+                &weak,
+                &[4, 5],
+                generate,
+                &Reporter::silent(),
+                0.0,
+                judging,
+                &on_threads,
+            )
+            .unwrap()
+            .expect("this process folds")
+            .0
+        };
+        let (worst, verdict) = (rows(Judging::WorstOnly), rows(Judging::UntilVerdict));
+        for (w, v) in worst.iter().zip(&verdict) {
+            assert!(!w.safe() && !v.safe(), "{w:?}\n{v:?}");
+            assert!(v.max_utilisation <= w.max_utilisation * (1.0 + 1e-6));
+            assert!(v.steps_judged < w.steps_judged, "{w:?}\n{v:?}");
+        }
     }
 
     #[test]
