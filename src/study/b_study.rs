@@ -1218,12 +1218,13 @@ mod tests {
         // pressures, the holding row as worst-only's, a failing row's
         // maximum a lower bound (marked where it is below the true one),
         // fewer steps judged where a failing row would go on.
-        let model = Model::default_catom().with_connector(30e3, Bending::RigidHinge);
-        let rows = |judging: Judging| {
+        // The 2-pyramid's rows at `kpa` (rigid hinge) for `lengths`.
+        let pyramid_rows = |kpa: f64, lengths: &[usize], judging: Judging| {
+            let model = Model::default_catom().with_connector(kpa * 1e3, Bending::RigidHinge);
             let generate = family("pyramid", 3.6, Some(2), None).unwrap();
-            let (rows, _, _) = study_rows(
+            study_rows(
                 &model,
-                &[4, 6, 9],
+                lengths,
                 generate,
                 &Reporter::silent(),
                 0.0,
@@ -1231,9 +1232,10 @@ mod tests {
                 &on_threads,
             )
             .unwrap()
-            .expect("this process folds");
-            rows
+            .expect("this process folds")
+            .0
         };
+        let rows = |judging: Judging| pyramid_rows(30.0, &[4, 6, 9], judging);
         let (every, worst, verdict) = (
             rows(Judging::Every),
             rows(Judging::WorstOnly),
@@ -1295,23 +1297,10 @@ mod tests {
         // At 5 kPa b = 4 and 5 fail too, and worst-only goes on judging
         // after their first failing step (12 steps each); until the
         // verdict, one batch of 4 decides each.
-        let weak = Model::default_catom().with_connector(5e3, Bending::RigidHinge);
-        let rows = |judging: Judging| {
-            let generate = family("pyramid", 3.6, Some(2), None).unwrap();
-            study_rows(
-                &weak,
-                &[4, 5],
-                generate,
-                &Reporter::silent(),
-                0.0,
-                judging,
-                &on_threads,
-            )
-            .unwrap()
-            .expect("this process folds")
-            .0
-        };
-        let (worst, verdict) = (rows(Judging::WorstOnly), rows(Judging::UntilVerdict));
+        let (worst, verdict) = (
+            pyramid_rows(5.0, &[4, 5], Judging::WorstOnly),
+            pyramid_rows(5.0, &[4, 5], Judging::UntilVerdict),
+        );
         for (w, v) in worst.iter().zip(&verdict) {
             assert!(!w.safe() && !v.safe(), "{w:?}\n{v:?}");
             assert!(v.max_utilisation <= w.max_utilisation * (1.0 + 1e-6));
