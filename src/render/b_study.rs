@@ -58,8 +58,31 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
             .map_err(draw_err)?
             .label("every step, static analysis")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLUE.stroke_width(2)));
-        c.draw_series(sim.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
-            .map_err(draw_err)?;
+        // A row's maximum that is only a lower bound (poses or steps left
+        // unjudged, the table's "≥") is drawn hollow.
+        let at_least = |r: &crate::study::b_study::Row| r.max_utilisation_at_least;
+        c.draw_series(
+            study
+                .rows
+                .iter()
+                .zip(&sim)
+                .filter(|(r, _)| !at_least(r))
+                .map(|(_, &p)| Circle::new(p, 4, BLUE.filled())),
+        )
+        .map_err(draw_err)?;
+        if study.rows.iter().any(at_least) {
+            c.draw_series(
+                study
+                    .rows
+                    .iter()
+                    .zip(&sim)
+                    .filter(|(r, _)| at_least(r))
+                    .map(|(_, &p)| Circle::new(p, 5, BLUE.stroke_width(2))),
+            )
+            .map_err(draw_err)?
+            .label("≥: a lower bound (poses or steps left unjudged)")
+            .legend(|(x, y)| Circle::new((x + 9, y), 5, BLUE.stroke_width(2)));
+        }
         let closed: Vec<(f64, f64)> = study
             .rows
             .iter()
@@ -76,7 +99,9 @@ pub fn plot(study: &Study, path: &Path) -> Result<(), Error> {
                 .map(|&p| Cross::new(p, 5, RED.stroke_width(2))),
         )
         .map_err(draw_err)?;
-        crate::render::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
+        // Lower right: the curves rise with b, and a failing b's point
+        // near the top-left stays visible.
+        crate::render::legend(&mut c, SeriesLabelPosition::LowerRight)?;
 
         let pmax = study
             .rows

@@ -1423,6 +1423,18 @@ mod tests {
         crate::render::b_study_plot(&st, &p).unwrap();
         let bytes = std::fs::read(&p).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
+        // A maximum that is only a lower bound (≥) is drawn hollow, with
+        // its own legend entry; none without one.
+        let svg = |st: &Study| {
+            let p = dir.join("b.svg");
+            crate::render::b_study_plot(st, &p).unwrap();
+            std::fs::read_to_string(&p).unwrap()
+        };
+        let note = "a lower bound (poses or steps left unjudged)";
+        assert!(!svg(&st).contains(note));
+        let mut bounded = st.clone();
+        bounded.rows[2].max_utilisation_at_least = true;
+        assert!(svg(&bounded).contains(note));
         std::fs::remove_dir_all(&dir).ok();
     }
 }
