@@ -153,8 +153,11 @@ pub fn utilisation(load: &ConnectorLoad, cap: &Capacity) -> (f64, Mode) {
 /// above 1, its clamp having shrunk too).
 pub fn scale_within(load: &ConnectorLoad, cap: &Capacity) -> f64 {
     let (u, _) = utilisation(load, cap);
-    if u.is_nan() || u <= 1.0 {
-        return if u.is_nan() { f64::NAN } else { 1.0 };
+    if u.is_nan() {
+        return f64::NAN;
+    }
+    if u <= 1.0 {
+        return 1.0;
     }
     let p = cap.tension();
     if p.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {

@@ -88,6 +88,13 @@ impl Row {
             Bending::Elastic => self.min_pressure_elastic,
         }
     }
+
+    /// Whether every step holds at pressure `p` (Pa) under `bending`: its
+    /// minimum pressure is at most `p`, and no step was left without a
+    /// finite bound (which could need more).
+    pub fn holds_at(&self, p: f64, bending: Bending) -> bool {
+        self.equilibria_unproved == 0 && self.min_pressure(bending) <= p * (1.0 + 1e-9)
+    }
 }
 
 /// `b_max` at one pressure, both criteria, simulated and closed-form.
@@ -519,7 +526,6 @@ pub fn study_rows(
         for f in findings {
             if f.bounded {
                 left = left.max(f.max_utilisation);
-                row.equilibria_unproved += usize::from(f.max_utilisation == f64::INFINITY);
             }
             row.fold(f);
         }
@@ -686,6 +692,7 @@ impl Row {
         // A bounded step was left bounded because its bound is no more
         // than the worst proved (see `prove_worst`): it cannot raise it.
         self.steps_bounded += usize::from(f.bounded);
+        self.equilibria_unproved += usize::from(f.bounded && f.max_utilisation == f64::INFINITY);
         if !f.bounded && f.max_utilisation > self.max_utilisation {
             self.max_utilisation = f.max_utilisation;
             self.critical_step = f.step;
@@ -730,12 +737,8 @@ pub fn assemble(
             let p = kpa * 1e3;
             SweepRow {
                 pressure_kpa: kpa,
-                b_max_rigid_hinge: prefix_max(&|r: &Row| {
-                    r.equilibria_unproved == 0 && r.min_pressure_rigid_hinge <= p * (1.0 + 1e-9)
-                }),
-                b_max_elastic: prefix_max(&|r: &Row| {
-                    r.equilibria_unproved == 0 && r.min_pressure_elastic <= p * (1.0 + 1e-9)
-                }),
+                b_max_rigid_hinge: prefix_max(&|r: &Row| r.holds_at(p, Bending::RigidHinge)),
+                b_max_elastic: prefix_max(&|r: &Row| r.holds_at(p, Bending::Elastic)),
                 closed_rigid_hinge: closed_branch_max(
                     &model.with_connector(p, Bending::RigidHinge),
                 ),
