@@ -35,7 +35,7 @@
 //! cell.
 
 use super::atom_search::{
-    Carry, Found, Legs, Op, Problem, Scene, lift, rest_spacing, slide_problem, tunnel_problem,
+    Carry, Found, Legs, Op, Problem, Scene, lift, rest_spacing, slide_problem,
 };
 use crate::error::InputError;
 use crate::lattice::config::ModuleId;
@@ -261,7 +261,8 @@ fn library(
     .as_ref()
 }
 
-/// A derived 1-TUNNEL ([`tunnel_problem`] with its legs), lifted to 3D.
+/// A derived 1-TUNNEL ([`super::atom_search::tunnel_problem`] with its
+/// legs), lifted to 3D.
 pub struct TunnelLibrary {
     pub legs: Legs,
     pub problem: Problem,
@@ -279,15 +280,14 @@ impl TunnelLibrary {
     }
 }
 
-/// Bound of the 1-TUNNEL searches (states, both directions together); the
-/// contracted model's moves are found within about 720,000.
-pub const TUNNEL_MAX_STATES: usize = 3_000_000;
-
 /// The 1-TUNNEL of the contracted model with `legs` (a leg meta-module
 /// behind the leaf A, one between the turn and the exit: each stands for
-/// a leg of any length, whose further meta-modules ride rigidly),
-/// searched once per process ([`Problem::solve_bidirectional`]); `None`
-/// for the expanded model (not derived: see `docs/atoms.md`).
+/// a leg of any length, whose further meta-modules ride rigidly), read
+/// once per process from its stored file and validated by replay
+/// ([`super::stored_move`]; its search, [`Problem::solve_bidirectional`],
+/// explores up to 720,000 states); `None` for the expanded model (not
+/// derived: see `docs/atoms.md`), or if the stored sequence fails that
+/// replay.
 pub fn tunnel_library(rest: AtomRest, legs: Legs) -> Option<&'static TunnelLibrary> {
     static CONTRACTED: [OnceLock<Option<TunnelLibrary>>; 4] = [const { OnceLock::new() }; 4];
     if rest != AtomRest::Contracted {
@@ -295,8 +295,7 @@ pub fn tunnel_library(rest: AtomRest, legs: Legs) -> Option<&'static TunnelLibra
     }
     CONTRACTED[usize::from(legs.behind) + 2 * usize::from(legs.ahead)]
         .get_or_init(|| {
-            let (problem, _) = tunnel_problem(rest, legs);
-            let found = problem.solve_bidirectional(2, TUNNEL_MAX_STATES)?;
+            let (problem, found) = super::stored_move::contracted_tunnel(legs).ok()?;
             let mut end = problem.start.clone();
             for st in &found.steps {
                 end = end.step(st, &problem.anchors, problem.eps)?;

@@ -523,6 +523,12 @@ impl Problem {
         None
     }
 
+    /// Whether `s` meets the goal: any assignment of an exchange group's
+    /// atoms to the group's goal cells, with the goal's faces and bonds.
+    pub fn meets_goal(&self, s: &Scene) -> bool {
+        self.canon(s.clone()) == self.canon(self.goal.clone())
+    }
+
     /// The state as the search keeps it: canonical within the exchange
     /// groups.
     fn canon(&self, s: Scene) -> Scene {
@@ -892,6 +898,11 @@ pub fn expanded_slide_problem(carry: Carry) -> (Problem, Vec<char>) {
 /// [`expanded_slide_problem`] (found in 343,950 states, about a minute in
 /// release).
 pub const EXPANDED_SLIDE_SEARCH: (usize, usize) = (2, 600_000);
+
+/// [`Problem::solve_bidirectional`]'s weight and state bound for the
+/// contracted model's 1-TUNNELs ([`tunnel_problem`]): each is found within
+/// about 720,000 states.
+pub const TUNNEL_SEARCH: (usize, usize) = (2, 3_000_000);
 
 /// The SLIDE of a lone meta-module between two walls (seed 004 Alg. 1: a
 /// moving wall component of one meta-module with stationary neighbours on

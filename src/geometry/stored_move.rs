@@ -1,13 +1,17 @@
 //! Atom sequences whose search is too long to repeat in every process (the
-//! expanded model's SLIDE: about a minute in release), stored under
-//! `models/moves/` and **validated by replay whenever they are loaded**:
-//! a stored sequence is never taken on trust. Replay uses the search's own
-//! step rules ([`super::atom_search::Scene::step`]: kinematics from the frame, exact
-//! moving-box collisions, connectivity) and the search's own limits (only
-//! the actors act, with the allowed faces; latches only with the latchable
-//! atoms); it must end exactly at the goal, every atom in its own goal
-//! cell (the expansion keeps each slider's atoms). `reconfcheck
-//! derive-moves` runs the search again and writes or checks the file.
+//! expanded model's SLIDE: about a minute in release; the contracted
+//! model's four 1-TUNNELs: up to 720,000 states each, minutes in a debug
+//! build), stored under `models/moves/` and **validated by replay whenever
+//! they are loaded**: a stored sequence is never taken on trust. Replay
+//! uses the search's own step rules ([`super::atom_search::Scene::step`]:
+//! kinematics from the frame, exact moving-box collisions, connectivity)
+//! and the search's own limits (only the actors act, with the allowed
+//! faces; latches only with the latchable atoms); it must end exactly at
+//! the goal: for the SLIDE every atom in its own goal cell (the expansion
+//! keeps each slider's atoms), for a 1-TUNNEL any of an exchange group's
+//! atoms on the group's goal cells, as the search's goal is met.
+//! `reconfcheck derive-moves` runs the searches again and writes or checks
+//! the files.
 //!
 //! The file is JSON: what was searched (in words), the search's state
 //! count, and the parallel steps, one string per operation:
@@ -15,7 +19,8 @@
 //! numbered as in the scene of the move's problem).
 
 use super::atom_search::{
-    Carry, EXPANDED_SLIDE_SEARCH, Found, Op, Problem, expanded_slide_problem,
+    Carry, EXPANDED_SLIDE_SEARCH, Found, Legs, Op, Problem, TUNNEL_SEARCH, expanded_slide_problem,
+    tunnel_problem,
 };
 use crate::error::InputError;
 use crate::lattice::{AtomRest, Face};
@@ -109,9 +114,15 @@ impl StoredMove {
 
     /// The sequence, replayed in `problem` and checked: every operation
     /// within the problem's limits, every step valid by the certifier's
-    /// rules, ending exactly at the goal. Errors name the file, the step
-    /// (1-based) and, where one is at fault, the atom.
-    pub fn validated(&self, problem: &Problem, file: &str) -> Result<Found, InputError> {
+    /// rules, ending exactly at the goal (`end`: each atom on its own goal
+    /// cell, or the search's goal within exchange groups). Errors name the
+    /// file, the step (1-based) and, where one is at fault, the atom.
+    pub fn validated(
+        &self,
+        problem: &Problem,
+        end: GoalMatch,
+        file: &str,
+    ) -> Result<Found, InputError> {
         let n = problem.start.pos.len();
         let mut scene = problem.start.clone();
         let mut steps = Vec::with_capacity(self.steps.len());
@@ -153,10 +164,19 @@ impl StoredMove {
                 })?;
             steps.push(ops);
         }
-        if scene != problem.goal {
-            return Err(InputError::new(
-                "the sequence does not end with every atom at its own goal, at rest, with the goal's bonds",
-            )
+        let reached = match end {
+            GoalMatch::OwnCells => scene == problem.goal,
+            GoalMatch::WithinGroups => problem.meets_goal(&scene),
+        };
+        if !reached {
+            return Err(InputError::new(match end {
+                GoalMatch::OwnCells => {
+                    "the sequence does not end with every atom at its own goal, at rest, with the goal's bonds"
+                }
+                GoalMatch::WithinGroups => {
+                    "the sequence does not end at the goal (its cells, faces and bonds, atoms exchanged only within their groups)"
+                }
+            })
             .in_file(file));
         }
         Ok(Found {
@@ -165,6 +185,16 @@ impl StoredMove {
             states_explored: self.states_explored,
         })
     }
+}
+
+/// How a replayed sequence must meet its problem's goal.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum GoalMatch {
+    /// Every atom on its own goal cell.
+    OwnCells,
+    /// As the search's goal: an exchange group's atoms on its cells in
+    /// any order.
+    WithinGroups,
 }
 
 /// What the expanded SLIDE's record says was searched.
@@ -194,7 +224,7 @@ pub fn expanded_slide(carry: Carry) -> Result<(Problem, Found), InputError> {
     let mut out = None;
     for c in [Carry::None, Carry::Behind] {
         let (p, _) = expanded_slide_problem(c);
-        let found = stored.validated(&p, EXPANDED_SLIDE_FILE)?;
+        let found = stored.validated(&p, GoalMatch::OwnCells, EXPANDED_SLIDE_FILE)?;
         if c == carry {
             out = Some((p, found));
         }
@@ -211,6 +241,104 @@ pub fn expanded_slide(carry: Carry) -> Result<(Problem, Found), InputError> {
 /// The stored expanded SLIDE's text (what `derive-moves --check` compares).
 pub fn expanded_slide_text() -> &'static str {
     EXPANDED_SLIDE_TEXT
+}
+
+/// One of the stored moves: its file, its text, and its search.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum StoredId {
+    ExpandedSlide,
+    ContractedTunnel(Legs),
+}
+
+impl StoredId {
+    pub const ALL: [StoredId; 5] = [
+        StoredId::ExpandedSlide,
+        StoredId::ContractedTunnel(Legs::ALL[0]),
+        StoredId::ContractedTunnel(Legs::ALL[1]),
+        StoredId::ContractedTunnel(Legs::ALL[2]),
+        StoredId::ContractedTunnel(Legs::ALL[3]),
+    ];
+
+    /// Where it is stored (relative to the repository) and the text
+    /// compiled in from there.
+    pub fn file(self) -> (&'static str, &'static str) {
+        match self {
+            StoredId::ExpandedSlide => (EXPANDED_SLIDE_FILE, EXPANDED_SLIDE_TEXT),
+            StoredId::ContractedTunnel(legs) => match (legs.behind, legs.ahead) {
+                (false, false) => (
+                    "models/moves/tunnel-contracted-alone.json",
+                    include_str!("../../models/moves/tunnel-contracted-alone.json"),
+                ),
+                (true, false) => (
+                    "models/moves/tunnel-contracted-leg-in.json",
+                    include_str!("../../models/moves/tunnel-contracted-leg-in.json"),
+                ),
+                (false, true) => (
+                    "models/moves/tunnel-contracted-leg-out.json",
+                    include_str!("../../models/moves/tunnel-contracted-leg-out.json"),
+                ),
+                (true, true) => (
+                    "models/moves/tunnel-contracted-both-legs.json",
+                    include_str!("../../models/moves/tunnel-contracted-both-legs.json"),
+                ),
+            },
+        }
+    }
+
+    /// Its name on the command line: the file's stem.
+    pub fn name(self) -> &'static str {
+        let file = self.file().0;
+        let stem = file.rsplit('/').next().unwrap_or(file);
+        stem.strip_suffix(".json").unwrap_or(stem)
+    }
+
+    /// Runs its search again; `None` if the search finds nothing within
+    /// its bounds.
+    pub fn derive(self) -> Option<StoredMove> {
+        match self {
+            StoredId::ExpandedSlide => derive_expanded_slide(),
+            StoredId::ContractedTunnel(legs) => derive_contracted_tunnel(legs),
+        }
+    }
+}
+
+/// The name a 1-TUNNEL's record carries.
+fn tunnel_name(legs: Legs) -> String {
+    format!("1-tunnel, {}", legs.name())
+}
+
+/// Searches the contracted model's 1-TUNNEL with `legs` again (up to
+/// about 720,000 states: seconds to a minute in release).
+pub fn derive_contracted_tunnel(legs: Legs) -> Option<StoredMove> {
+    let (p, _) = tunnel_problem(AtomRest::Contracted, legs);
+    let (weight, states) = TUNNEL_SEARCH;
+    let found = p.solve_bidirectional(weight, states)?;
+    let searched = format!(
+        "atom_search::tunnel_problem(Contracted, Legs {{ behind: {}, ahead: {} }}): the leaf A at meta cell (0, 1) pushed into the turn B (0, 0), whose mass pops out at (1, 0), B hanging on L (-1, 0); A's and B's atoms act and are one exchange group, a leg (D behind A, E ahead) moves rigidly; Problem::solve_bidirectional({weight}, {states})",
+        legs.behind, legs.ahead
+    );
+    Some(StoredMove::of(
+        &tunnel_name(legs),
+        AtomRest::Contracted,
+        &searched,
+        &found,
+    ))
+}
+
+/// The stored contracted 1-TUNNEL with `legs`, validated by replay in its
+/// problem (the search's goal, A's and B's atoms exchanged).
+pub fn contracted_tunnel(legs: Legs) -> Result<(Problem, Found), InputError> {
+    let (file, text) = StoredId::ContractedTunnel(legs).file();
+    let stored = StoredMove::parse(text, file)?;
+    if stored.name != tunnel_name(legs) || stored.model != AtomRest::Contracted {
+        return Err(
+            InputError::new(format!("not the contracted model's {}", tunnel_name(legs)))
+                .in_file(file),
+        );
+    }
+    let (p, _) = tunnel_problem(AtomRest::Contracted, legs);
+    let found = stored.validated(&p, GoalMatch::WithinGroups, file)?;
+    Ok((p, found))
 }
 
 #[cfg(test)]
@@ -268,7 +396,7 @@ mod tests {
         let good = StoredMove::parse(EXPANDED_SLIDE_TEXT, "f").unwrap();
         let (p, _) = expanded_slide_problem(Carry::None);
         let check = |m: &StoredMove| {
-            m.validated(&p, "f.json")
+            m.validated(&p, GoalMatch::OwnCells, "f.json")
                 .map(|_| ())
                 .map_err(|e| e.to_string())
         };
@@ -300,5 +428,68 @@ mod tests {
         let mut m = good.clone();
         m.steps.insert(3, Vec::new());
         assert!(check(&m).unwrap_err().contains("step 4"));
+    }
+
+    /// Every stored 1-TUNNEL replays to its goal; the one-leg moves are the
+    /// documented sizes (docs/atoms.md: 2D slice operations and parallel
+    /// steps, before lifting); and A's and B's atoms end exchanged, so a
+    /// check that wanted each atom on its own goal cell would refuse them.
+    #[test]
+    fn the_stored_tunnels_replay_to_the_search_goal_with_atoms_exchanged() {
+        for legs in Legs::ALL {
+            let (p, found) = contracted_tunnel(legs).expect("valid");
+            assert!(!found.steps.is_empty());
+            let (file, text) = StoredId::ContractedTunnel(legs).file();
+            let stored = StoredMove::parse(text, file).unwrap();
+            let own = stored.validated(&p, GoalMatch::OwnCells, file);
+            assert!(
+                own.unwrap_err().to_string().contains("own goal"),
+                "{}",
+                legs.name()
+            );
+        }
+    }
+
+    /// A stored 1-TUNNEL cut short, or replayed in another leg's scene, is
+    /// refused.
+    #[test]
+    fn a_tunnel_cut_short_or_in_another_scene_is_refused() {
+        let id = StoredId::ContractedTunnel(Legs::ALL[0]);
+        let (file, text) = id.file();
+        let good = StoredMove::parse(text, file).unwrap();
+        let (p, _) = tunnel_problem(AtomRest::Contracted, Legs::ALL[0]);
+        let mut short = good.clone();
+        short.steps.pop();
+        let e = short
+            .validated(&p, GoalMatch::WithinGroups, file)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("does not end at the goal") && e.contains(file),
+            "{e}"
+        );
+        let (other, _) = tunnel_problem(AtomRest::Contracted, Legs::ALL[3]);
+        assert!(
+            good.validated(&other, GoalMatch::WithinGroups, file)
+                .is_err()
+        );
+    }
+
+    /// The searches run again find exactly the stored 1-TUNNELs (minutes
+    /// in a test build: `cargo test --release -- --ignored
+    /// the_stored_tunnels_are`; `reconfcheck derive-moves --check` does
+    /// the same).
+    #[test]
+    #[ignore = "searches of up to 720,000 states; reconfcheck derive-moves --check runs them too"]
+    fn the_stored_tunnels_are_what_the_search_finds() {
+        for legs in Legs::ALL {
+            let id = StoredId::ContractedTunnel(legs);
+            let (file, text) = id.file();
+            assert_eq!(
+                id.derive(),
+                Some(StoredMove::parse(text, file).unwrap()),
+                "{file}"
+            );
+        }
     }
 }

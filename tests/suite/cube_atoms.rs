@@ -606,6 +606,30 @@ fn a_one_tunnel_with_long_legs_certifies_atom_by_atom_turned_and_mirrored() {
     }
 }
 
+/// `derive-moves --move` with a name that is no stored move is refused
+/// (exit 2) before any search, listing the stored moves.
+#[test]
+fn derive_moves_refuses_an_unknown_move_naming_the_known_ones() {
+    let o = common::bin()
+        .args([
+            "derive-moves",
+            "--check",
+            "--move",
+            "tunnel-contracted-sideways",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("tunnel-contracted-sideways")
+            && err.contains("tunnel-contracted-both-legs")
+            && err.contains("slide-expanded")
+            && !err.contains("searching"),
+        "{err}"
+    );
+}
+
 #[test]
 fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
     let (metas, _) = tunnel_robot(|c| c);
