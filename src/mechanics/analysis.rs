@@ -18,7 +18,7 @@ use super::model::{Capacity, Model};
 use super::pose_hull;
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
-use super::structure::{End, Link, Structure};
+use super::structure::{End, Link, Point, Structure};
 use glam::DVec3;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -516,6 +516,75 @@ fn spared(bound: f64, smallest: f64, tolerance: f64) -> bool {
     tolerance > 0.0 && bound >= 1.0 && bound >= (1.0 - tolerance) * smallest
 }
 
+/// How far (units of `d`) a sample may lie off the segment between its
+/// two tangent poses and still count as on it: round-off of
+/// [`super::structure::tangent_points`], whose loads then differ by a
+/// relative 1e-12, far below the limit analysis's own tolerance.
+const ON_TANGENT_TOLERANCE: f64 = 1e-12;
+
+/// Which poses of `failing` the limit analysis may pass over without
+/// changing the smallest load factor: a sample `k` (not the first or the
+/// last) whose movers all lie on the segments between the tangent poses
+/// of its two intervals, `k − 1` and `k`, with one weight for all, when
+/// both those poses are in `failing` too. The loads are affine in the
+/// movers' centres, and the loads a component carries within capacity
+/// form a convex set holding zero, so its factor is at least the smaller
+/// of the two tangent poses' (scale both down to that factor: the convex
+/// combination is admissible). One group of movers turning at one rate
+/// (a single tangent pose per interval): the tangent lines at sample `k`
+/// of its two intervals are one line, with the sample between their
+/// tangent points. Anything else (several groups, a straight path's
+/// midpoints off the line, a path not on one circle) is checked
+/// numerically and, failing the check, solved.
+fn dominated_samples(s: &Structure, failing: &[(Option<usize>, f64)]) -> Vec<bool> {
+    let mut out = vec![false; failing.len()];
+    let Some(n) = s.hanging.first().map(|h| h.path.len()) else {
+        return out;
+    };
+    let one_group = s
+        .hanging
+        .iter()
+        .all(|h| h.group == 0 && h.path.len() == n && h.hull.len() + 1 == n);
+    let tangents = s.between.len() + 1 == n
+        && s.between
+            .iter()
+            .enumerate()
+            .all(|(v, p)| p.as_slice() == [Point::Tangent(v)]);
+    if n < 3 || !one_group || !tangents {
+        return out;
+    }
+    let mut present = vec![false; 2 * n - 1];
+    for &(pose, _) in failing {
+        if let Some(k) = pose.filter(|&k| k < present.len()) {
+            present[k] = true;
+        }
+    }
+    for (i, &(pose, _)) in failing.iter().enumerate() {
+        let Some(k) = pose.filter(|&k| k >= 1 && k + 1 < n) else {
+            continue;
+        };
+        if !(present[n + k - 1] && present[n + k]) {
+            continue;
+        }
+        // The one weight α with sample = b + α·(a − b), a and b the
+        // tangent points before and after it, least squares over movers.
+        let (mut num, mut den) = (0.0, 0.0);
+        for h in &s.hanging {
+            let (a, b, m) = (h.hull[k - 1], h.hull[k], h.path[k]);
+            num += (m - b).dot(a - b);
+            den += (a - b).length_squared();
+        }
+        let alpha = if den > 0.0 { num / den } else { 0.0 };
+        let on_segment = (0.0..=1.0).contains(&alpha)
+            && s.hanging.iter().all(|h| {
+                let (a, b, m) = (h.hull[k - 1], h.hull[k], h.path[k]);
+                (m - (b + alpha * (a - b))).length() <= ON_TANGENT_TOLERANCE
+            });
+        out[i] = on_segment;
+    }
+    out
+}
+
 /// The smaller factor; a NaN (a failed solve) sticks, so that it reads as
 /// overloaded wherever it ends up.
 fn lowest(x: f64, y: f64) -> f64 {
@@ -882,7 +951,8 @@ impl Analyzer {
                     f_unit
                 })
                 .collect()
-        } else if poses.len() > 1 {
+        } else if poses.iter().any(Option::is_some) {
+            // (A single sampled pose too: a path of one sample.)
             poses
                 .iter()
                 .map(|&pose| local_loads(s, pose, &local))
@@ -1598,9 +1668,15 @@ impl Analyzer {
         // (`limit::load_factor_from`): the first wave is that one pose.
         let (mut start, mut first_wave) = (self.limit_setting, true);
         let mut failed = false;
+        let dominated = dominated_samples(s, failing);
         for (i, &(pose, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
+            }
+            if dominated[i] {
+                // Its factor is at least the smaller of its two tangent
+                // poses', which the loop takes in their turn.
+                continue;
             }
             if failed {
                 // The step fails already, and this pose's bound exceeds the
@@ -1634,7 +1710,8 @@ impl Analyzer {
                     if ahead.len() >= wave {
                         break;
                     }
-                    let known = solved[j].is_some()
+                    let known = dominated[j]
+                        || solved[j].is_some()
                         || self
                             .spared_by(s, part, &fields, p, out.capacities)
                             .is_some();

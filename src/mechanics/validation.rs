@@ -639,6 +639,12 @@ fn the_actuator_hold_is_reported_apart_from_the_connectors() {
 /// mover swinging on its upper tip towards `to` (`mirror`: the image in
 /// y = 0): it holds only through the limit analysis at every pose.
 fn deep_swing(n: i32, to: Cell, mirror: bool) -> Structure {
+    wall_swing(n, to, mirror, false)
+}
+
+/// [`deep_swing`], or (`resting`) the same wall on the ground beside a
+/// second ground row, nothing fixed.
+fn wall_swing(n: i32, to: Cell, mirror: bool, resting: bool) -> Structure {
     let flip = |c: Cell| if mirror { Cell::new(c.x, -c.y, c.z) } else { c };
     let mut cells: Vec<Cell> = (0..2)
         .flat_map(|z| (0..=n).map(move |x| Cell::new(x, 0, z)))
@@ -655,8 +661,93 @@ fn deep_swing(n: i32, to: Cell, mirror: bool) -> Structure {
             route: Route::Octagonal,
         },
     );
+    if resting {
+        // A second ground row beside the first, so that the wall stands.
+        cells.extend((0..=n).map(|x| Cell::new(x, -1, 0)));
+    }
     let cells: Vec<Cell> = cells.into_iter().map(flip).collect();
-    structure(&FccLattice, None, &cells, &[0], &[mover])
+    if resting {
+        structure(
+            &FccLattice,
+            Some(Ground { layer: 0 }),
+            &cells,
+            &[],
+            &[mover],
+        )
+    } else {
+        structure(&FccLattice, None, &cells, &[0], &[mover])
+    }
+}
+
+/// A sample lying between the tangent poses of its two intervals is not
+/// solved: the loads are affine in the mover's centre and the loads a
+/// component carries within capacity are convex, so its factor is at
+/// least the smaller of theirs. The step's factor is still the smallest
+/// of every pose's own analysis, enumerated here one pose at a time, on
+/// a fixed root (mirrored too) and resting on the ground; a sample moved
+/// off that segment is solved again. (The resting wall's image in y = 0
+/// is not that wall mirrored: layer 1 sits half a cell along +y, so its
+/// image leans the other way over its second row, and the elastic screen
+/// clears it.)
+#[test]
+fn a_sample_between_its_tangent_poses_is_not_solved_and_the_factor_is_still_every_poses_smallest() {
+    let model = Model::default_catom();
+    let analyse = |s: &Structure| Analyzer::new(model.clone(), false).analyse(s);
+    let cases = [
+        (7, Cell::new(7, 1, 1), false),
+        (8, Cell::new(8, 0, 2), false),
+        (3, Cell::new(3, 1, 1), true),
+    ];
+    for (n, to, resting) in cases {
+        for mirror in [false, true].into_iter().filter(|&m| !(m && resting)) {
+            let s = wall_swing(n, to, mirror, resting);
+            let a = analyse(&s);
+            let lambda = a.load_factor.expect("judged by the limit analysis");
+            let h = &s.hanging[0];
+            let case = format!("{n} {resting} {mirror}");
+            assert_eq!(
+                (h.path.len(), h.hull.len(), a.between_poses),
+                (25, 24, 24),
+                "{case}"
+            );
+            // The two end samples and the 24 tangent poses, of 49.
+            assert_eq!(a.limit_analyses, 26, "{case}");
+            // Every pose alone: the mover's centre at one sample or one
+            // tangent point.
+            let alone = |c: DVec3| {
+                let mut one = s.clone();
+                one.hanging[0].path = vec![c];
+                one.hanging[0].hull.clear();
+                one.between.clear();
+                let b = analyse(&one);
+                assert_eq!(b.limit_analyses, 1);
+                b.load_factor.expect("judged by the limit analysis")
+            };
+            let ends_and_tangents = [h.path[0], h.path[24]]
+                .into_iter()
+                .chain(h.hull.iter().copied())
+                .map(alone)
+                .fold(f64::INFINITY, f64::min);
+            let every = h.path[1..24]
+                .iter()
+                .map(|&c| alone(c))
+                .fold(ends_and_tangents, f64::min);
+            assert!(
+                (lambda - ends_and_tangents).abs() <= 1e-12 * lambda,
+                "{case}: {lambda} against {ends_and_tangents}"
+            );
+            // The samples passed over are no lower, but for the proof's
+            // round-off (each factor is proved from the solver's
+            // equilibrium, a little under the optimum).
+            assert!(
+                every <= lambda * (1.0 + 1e-12) && lambda <= every * (1.0 + 1e-5),
+                "{case}: {lambda} against {every}"
+            );
+            let mut bent = s.clone();
+            bent.hanging[0].path[12] += 1e-6 * s.gravity;
+            assert_eq!(analyse(&bent).limit_analyses, 27);
+        }
+    }
 }
 
 #[test]
@@ -681,13 +772,14 @@ fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
             let exact = on(1, &s, 0.0);
             let lambda = exact.load_factor.expect("judged by the limit analysis");
             // 25 samples, and the 24 tangent poses between them (one
-            // mover: each interval's triangle), none cleared elastically.
-            assert!(lambda > 1.0 && exact.limit_analyses == 49, "{lambda}");
+            // mover: each interval's triangle), none cleared elastically;
+            // the samples between two tangent poses are not solved.
+            assert!(lambda > 1.0 && exact.limit_analyses == 26, "{lambda}");
             assert_eq!(exact.between_poses, 24);
             let spared = on(1, &s, tau);
             let skipping = spared.load_factor.unwrap();
             assert_eq!(spared.verdict(), exact.verdict());
-            assert!(spared.limit_analyses < exact.limit_analyses / 2);
+            assert!(spared.limit_analyses < exact.limit_analyses);
             // The reported factor is at most 1/(1 − τ) above the exact one,
             // never below it.
             assert!(skipping >= lambda * (1.0 - 1e-9), "{skipping} < {lambda}");
