@@ -145,18 +145,23 @@ pub fn orders(targets: &[Cell]) -> Vec<(&'static str, Vec<Cell>)> {
 
 /// Derives the operation of `scene`: strictly (no sliding contact) if
 /// possible, else with sliding contact allowed (still no collision); in
-/// each mode the first order of [`orders`] that reaches every goal cell.
+/// each mode the first order of [`orders`] that reaches every goal cell;
+/// all of that within [`SEARCH_BUDGET`] states, then, if none does,
+/// within [`DEEP_SEARCH_BUDGET`] (what the horizontal FULL Assemble
+/// needs; the operations found within the first are kept as they were).
 pub fn derive(dir: Direction, fill: State) -> Result<OperationPlan, InputError> {
     let scene = OperationScene::new(dir, fill);
     let mut last = None;
-    for strict in [true, false] {
-        for (name, order) in orders(&scene.targets()) {
-            match plan(&scene, &order, strict) {
-                Ok(mut p) => {
-                    p.order = name;
-                    return Ok(p);
+    for budget in [SEARCH_BUDGET, DEEP_SEARCH_BUDGET] {
+        for strict in [true, false] {
+            for (name, order) in orders(&scene.targets()) {
+                match plan(&scene, &order, strict, budget) {
+                    Ok(mut p) => {
+                        p.order = name;
+                        return Ok(p);
+                    }
+                    Err(e) => last = Some(e),
                 }
-                Err(e) => last = Some(e),
             }
         }
     }
@@ -204,6 +209,14 @@ pub fn move_catoms(
 
 /// States the depth-first search of [`move_catoms`] may expand.
 pub const SEARCH_BUDGET: usize = 300;
+
+/// The budget tried where [`SEARCH_BUDGET`] (or [`FILL_SEARCH_BUDGET`])
+/// finds no order: filling a meta-module's interior from the side, whose
+/// cell at the leader's level and one layer up is reached only after
+/// the right few of its neighbours are placed (the four horizontal FULL
+/// Assembles are found strictly, bottom-up, within 3,000 to 5,000 states,
+/// about 2 s each in release).
+pub const DEEP_SEARCH_BUDGET: usize = 10_000;
 
 /// The budget for filling a meta-module's interior inside a structure
 /// (the planner's compression): its neighbours, FULL already, leave the
@@ -276,7 +289,12 @@ impl Dfs<'_> {
     }
 }
 
-fn plan(scene: &OperationScene, order: &[Cell], strict: bool) -> Result<OperationPlan, InputError> {
+fn plan(
+    scene: &OperationScene,
+    order: &[Cell],
+    strict: bool,
+    budget: usize,
+) -> Result<OperationPlan, InputError> {
     let mut s = Scene::new(Some(scene.ground));
     let mut role_of: Vec<Role> = Vec::new();
     for (id, c, role) in &scene.modules {
@@ -292,7 +310,7 @@ fn plan(scene: &OperationScene, order: &[Cell], strict: bool) -> Result<Operatio
         .map(|m| m.1)
         .collect();
     let start = s.clone();
-    let paths = move_catoms(&mut s, &sources, &targets, strict, SEARCH_BUDGET).map_err(|cell| {
+    let paths = move_catoms(&mut s, &sources, &targets, strict, budget).map_err(|cell| {
         InputError::new(format!(
             "RePoSt assemble-{} {}: no source catom can reach goal cell {cell}",
             match scene.fill {

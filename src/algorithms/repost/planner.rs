@@ -30,7 +30,7 @@
 
 use super::messages::{self, IterationRecord, Messages};
 use super::metamodule::{Meta, State, spanning_tree};
-use super::operations::{FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
+use super::operations::{DEEP_SEARCH_BUDGET, FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
 use super::pipeline::pipeline;
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
@@ -456,13 +456,18 @@ fn transport(
     } else {
         vec![targets.to_vec()]
     };
-    let budget = if fill {
-        FILL_SEARCH_BUDGET
+    // An interior the first budget does not fill in any region, mode or
+    // order is tried again with the deep one (filling from the side).
+    let budgets: &[usize] = if fill {
+        &[FILL_SEARCH_BUDGET, DEEP_SEARCH_BUDGET]
     } else {
-        SEARCH_BUDGET
+        &[SEARCH_BUDGET]
     };
     let mut last = targets[0];
-    for margin in [Some(0), Some(1), None] {
+    for (budget, margin) in budgets
+        .iter()
+        .flat_map(|&b| [Some(0), Some(1), None].map(|m| (b, m)))
+    {
         let mut s = scene.clone();
         match margin {
             Some(margin) => {
