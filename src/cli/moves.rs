@@ -5,7 +5,7 @@
 //! this command is how they are made.
 
 use reconfcheck::error::{Error, InputError, write_file};
-use reconfcheck::geometry::stored_move::{StoredId, StoredMove};
+use reconfcheck::geometry::stored_move::StoredId;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -44,9 +44,9 @@ pub fn run(a: Args) -> Result<u8, Error> {
     if chosen.is_empty() {
         chosen = StoredId::ALL.to_vec();
     }
+    let dir = a.out.unwrap_or_else(|| PathBuf::from("models/moves"));
     let mut differ = 0;
     for id in chosen {
-        let (file, text) = id.file();
         eprintln!(
             "searching {} (bidirectional; up to a minute each in a release build) …",
             id.name()
@@ -66,8 +66,8 @@ pub fn run(a: Args) -> Result<u8, Error> {
             t.elapsed().as_secs_f64()
         );
         if a.check {
-            let stored = StoredMove::parse(text, file)?;
-            if stored == found {
+            let file = id.file().0;
+            if id.load()? == found {
                 println!("{file}: the stored sequence is what the search finds");
             } else {
                 println!("{file}: the stored sequence differs from what the search finds");
@@ -75,13 +75,9 @@ pub fn run(a: Args) -> Result<u8, Error> {
             }
             continue;
         }
-        let dir = a
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("models/moves"));
         let out = dir.join(format!("{}.json", id.name()));
-        let text = serde_json::to_string_pretty(&found).expect("a stored move serialises") + "\n";
-        write_file(&out, text)?;
+        let json = serde_json::to_string_pretty(&found).expect("a stored move serialises") + "\n";
+        write_file(&out, json)?;
         println!("wrote {}", out.display());
     }
     Ok(u8::from(differ > 0))

@@ -205,9 +205,10 @@ pub fn derive_expanded_slide() -> Option<StoredMove> {
     let (p, _) = expanded_slide_problem(Carry::None);
     let (weight, states) = EXPANDED_SLIDE_SEARCH;
     let found = p.solve_bidirectional(weight, states)?;
+    let (name, model) = StoredId::ExpandedSlide.record();
     Some(StoredMove::of(
-        "slide",
-        AtomRest::Expanded,
+        &name,
+        model,
         EXPANDED_SLIDE_SEARCHED,
         &found,
     ))
@@ -217,10 +218,7 @@ pub fn derive_expanded_slide() -> Option<StoredMove> {
 /// behind the slider; the result is in the scene `carry` (`None` or
 /// `Behind`).
 pub fn expanded_slide(carry: Carry) -> Result<(Problem, Found), InputError> {
-    let stored = StoredMove::parse(EXPANDED_SLIDE_TEXT, EXPANDED_SLIDE_FILE)?;
-    if stored.name != "slide" || stored.model != AtomRest::Expanded {
-        return Err(InputError::new("not the expanded model's SLIDE").in_file(EXPANDED_SLIDE_FILE));
-    }
+    let stored = StoredId::ExpandedSlide.load()?;
     let mut out = None;
     for c in [Carry::None, Carry::Behind] {
         let (p, _) = expanded_slide_problem(c);
@@ -236,11 +234,6 @@ pub fn expanded_slide(carry: Carry) -> Result<(Problem, Found), InputError> {
         ))
         .in_file(EXPANDED_SLIDE_FILE)
     })
-}
-
-/// The stored expanded SLIDE's text (what `derive-moves --check` compares).
-pub fn expanded_slide_text() -> &'static str {
-    EXPANDED_SLIDE_TEXT
 }
 
 /// One of the stored moves: its file, its text, and its search.
@@ -285,6 +278,33 @@ impl StoredId {
         }
     }
 
+    /// The move and model its record must name.
+    fn record(self) -> (String, AtomRest) {
+        match self {
+            StoredId::ExpandedSlide => ("slide".into(), AtomRest::Expanded),
+            StoredId::ContractedTunnel(legs) => {
+                (format!("1-tunnel, {}", legs.name()), AtomRest::Contracted)
+            }
+        }
+    }
+
+    /// Its record, read from the compiled-in text, refused (naming the
+    /// file) unless it names this move and model; not yet validated
+    /// ([`StoredMove::validated`] replays it).
+    pub fn load(self) -> Result<StoredMove, InputError> {
+        let (file, text) = self.file();
+        let stored = StoredMove::parse(text, file)?;
+        let (name, model) = self.record();
+        if stored.name != name || stored.model != model {
+            return Err(InputError::new(format!(
+                "not the {} model's {name}",
+                format!("{model:?}").to_lowercase()
+            ))
+            .in_file(file));
+        }
+        Ok(stored)
+    }
+
     /// Its name on the command line: the file's stem.
     pub fn name(self) -> &'static str {
         let file = self.file().0;
@@ -302,11 +322,6 @@ impl StoredId {
     }
 }
 
-/// The name a 1-TUNNEL's record carries.
-fn tunnel_name(legs: Legs) -> String {
-    format!("1-tunnel, {}", legs.name())
-}
-
 /// Searches the contracted model's 1-TUNNEL with `legs` again (up to
 /// about 720,000 states: seconds to a minute in release).
 pub fn derive_contracted_tunnel(legs: Legs) -> Option<StoredMove> {
@@ -317,27 +332,17 @@ pub fn derive_contracted_tunnel(legs: Legs) -> Option<StoredMove> {
         "atom_search::tunnel_problem(Contracted, Legs {{ behind: {}, ahead: {} }}): the leaf A at meta cell (0, 1) pushed into the turn B (0, 0), whose mass pops out at (1, 0), B hanging on L (-1, 0); A's and B's atoms act and are one exchange group, a leg (D behind A, E ahead) moves rigidly; Problem::solve_bidirectional({weight}, {states})",
         legs.behind, legs.ahead
     );
-    Some(StoredMove::of(
-        &tunnel_name(legs),
-        AtomRest::Contracted,
-        &searched,
-        &found,
-    ))
+    let (name, model) = StoredId::ContractedTunnel(legs).record();
+    Some(StoredMove::of(&name, model, &searched, &found))
 }
 
 /// The stored contracted 1-TUNNEL with `legs`, validated by replay in its
 /// problem (the search's goal, A's and B's atoms exchanged).
 pub fn contracted_tunnel(legs: Legs) -> Result<(Problem, Found), InputError> {
-    let (file, text) = StoredId::ContractedTunnel(legs).file();
-    let stored = StoredMove::parse(text, file)?;
-    if stored.name != tunnel_name(legs) || stored.model != AtomRest::Contracted {
-        return Err(
-            InputError::new(format!("not the contracted model's {}", tunnel_name(legs)))
-                .in_file(file),
-        );
-    }
+    let id = StoredId::ContractedTunnel(legs);
+    let stored = id.load()?;
     let (p, _) = tunnel_problem(AtomRest::Contracted, legs);
-    let found = stored.validated(&p, GoalMatch::WithinGroups, file)?;
+    let found = stored.validated(&p, GoalMatch::WithinGroups, id.file().0)?;
     Ok((p, found))
 }
 
@@ -430,15 +435,23 @@ mod tests {
         assert!(check(&m).unwrap_err().contains("step 4"));
     }
 
-    /// Every stored 1-TUNNEL replays to its goal; the one-leg moves are the
-    /// documented sizes (docs/atoms.md: 2D slice operations and parallel
-    /// steps, before lifting); and A's and B's atoms end exchanged, so a
+    /// Every stored 1-TUNNEL replays to its goal, at the documented sizes
+    /// (docs/atoms.md: 2D slice operations and parallel steps, before
+    /// lifting); and A's and B's atoms end exchanged, so a
     /// check that wanted each atom on its own goal cell would refuse them.
     #[test]
     fn the_stored_tunnels_replay_to_the_search_goal_with_atoms_exchanged() {
-        for legs in Legs::ALL {
+        // (operations, parallel steps) in the 2D slice, as docs/atoms.md
+        // has them (alone, a leg in, a leg out, both).
+        let sizes = [(20, 8), (46, 15), (46, 15), (58, 18)];
+        for (legs, size) in Legs::ALL.into_iter().zip(sizes) {
             let (p, found) = contracted_tunnel(legs).expect("valid");
-            assert!(!found.steps.is_empty());
+            assert_eq!(
+                (found.ops.len(), found.steps.len()),
+                size,
+                "{}",
+                legs.name()
+            );
             let (file, text) = StoredId::ContractedTunnel(legs).file();
             let stored = StoredMove::parse(text, file).unwrap();
             let own = stored.validated(&p, GoalMatch::OwnCells, file);

@@ -530,12 +530,13 @@ const ON_TANGENT_TOLERANCE: f64 = 1e-12;
 /// movers' centres, and the loads a component carries within capacity
 /// form a convex set holding zero, so its factor is at least the smaller
 /// of the two tangent poses' (scale both down to that factor: the convex
-/// combination is admissible). One group of movers turning at one rate
-/// (a single tangent pose per interval): the tangent lines at sample `k`
-/// of its two intervals are one line, with the sample between their
-/// tangent points. Anything else (several groups, a straight path's
-/// midpoints off the line, a path not on one circle) is checked
-/// numerically and, failing the check, solved.
+/// combination is admissible). Only for one group of movers turning at
+/// one rate (a single tangent pose per interval; with several groups a
+/// sample is a corner of its intervals' hulls and nothing is passed
+/// over): the tangent lines at sample `k` of its two intervals are one
+/// line, with the sample between their tangent points. That is checked
+/// numerically, and a sample off its segment (a path not on one circle)
+/// is solved.
 fn dominated_samples(s: &Structure, failing: &[(Option<usize>, f64)]) -> Vec<bool> {
     let mut out = vec![false; failing.len()];
     let Some(n) = s.hanging.first().map(|h| h.path.len()) else {
