@@ -18,7 +18,8 @@ use super::model::{Capacity, Model};
 use super::pose_hull;
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
-use super::structure::{End, Link, Point, Structure};
+use super::structure::{End, Link, Structure};
+use super::sweep_bisection;
 use glam::DVec3;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -105,7 +106,7 @@ pub struct Analysis {
     /// Limit analyses (LP/SOCP solves) this analysis took.
     pub limit_analyses: usize,
     /// Components the screen could not clear and the limit analysis did
-    /// not judge ([`Settings::limit_analysis`] off): `max_utilisation` is
+    /// not judge (`Settings::limit_analysis` off): `max_utilisation` is
     /// then an upper bound of the step's, and the verdict is not proved.
     pub bounded: usize,
     /// Poses between samples judged one by one ([`Structure::between`]):
@@ -122,10 +123,10 @@ pub struct Analysis {
     /// one) and sparse factorisations this analysis took.
     pub iterations: usize,
     pub factorizations: usize,
-    /// Region limit analyses ([`Settings::region_hops`]) this analysis
+    /// Region limit analyses (`Settings::region_hops`) this analysis
     /// took: one per failing pose, or one per corner of the few that hold
     /// the failing poses' mover moments where that is fewer
-    /// ([`pose_hull::enclosing`]).
+    /// (`pose_hull::enclosing`).
     pub region_analyses: usize,
 }
 
@@ -234,6 +235,10 @@ pub struct Settings {
     pub tolerance: f64,
     /// Rounds of releasing ground contacts in tension.
     pub max_release_rounds: usize,
+    /// The limit analysis finds a sweep's smallest factor by bisection
+    /// ([`sweep_bisection`]) where it applies; off, it solves every pose
+    /// (the comparison the tests make).
+    pub bisect_sweeps: bool,
     /// CG iterations allowed with a kept factor before it is refreshed.
     pub reuse_iterations: usize,
     /// The kept factor is tried only while at most this many bodies were
@@ -282,6 +287,7 @@ impl Default for Settings {
         Settings {
             tolerance: 1e-10,
             max_release_rounds: 30,
+            bisect_sweeps: true,
             reuse_iterations: REUSE_ITERATIONS,
             reuse_max_changed: REUSE_MAX_CHANGED,
             envelope: true,
@@ -490,10 +496,22 @@ fn balanced(k: &BlockMatrix, f: &[Vec6], q: &[Vec6]) -> bool {
 /// mover hanging on its pivot at sample `pose` of its path, or (`None`) at
 /// its largest horizontal lever — the reference pose of the elastic screen.
 fn body_loads(s: &Structure, pose: Option<usize>) -> Vec<Vec6> {
+    loads_with_moments(s, |h| mover_moment(s, h, pose))
+}
+
+/// [`body_loads`] with mover `h` centred at `centres[h]` (a point that is
+/// no pose: [`sweep_bisection::Corner::Centres`]).
+fn body_loads_at(s: &Structure, centres: &[DVec3]) -> Vec<Vec6> {
+    loads_with_moments(s, |h| moment_at(s, h, centres[h]))
+}
+
+/// Every module's weight, and each mover's on its pivot with the moment
+/// `moment(h)`.
+fn loads_with_moments(s: &Structure, moment: impl Fn(usize) -> DVec3) -> Vec<Vec6> {
     let g = s.gravity;
     let mut f = vec![Vec6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0); s.bodies.len()];
     for (i, h) in s.hanging.iter().enumerate() {
-        let m = mover_moment(s, i, pose);
+        let m = moment(i);
         f[h.pivot] += Vec6::new(g.x, g.y, g.z, m.x, m.y, m.z);
     }
     f
@@ -516,12 +534,6 @@ fn spared(bound: f64, smallest: f64, tolerance: f64) -> bool {
     tolerance > 0.0 && bound >= 1.0 && bound >= (1.0 - tolerance) * smallest
 }
 
-/// How far (units of `d`) a sample may lie off the segment between its
-/// two tangent poses and still count as on it: round-off of
-/// [`super::structure::tangent_points`], whose loads then differ by a
-/// relative 1e-12, far below the limit analysis's own tolerance.
-const ON_TANGENT_TOLERANCE: f64 = 1e-12;
-
 /// Which poses of `failing` the limit analysis may pass over without
 /// changing the smallest load factor: a sample `k` (not the first or the
 /// last) whose movers all lie on the segments between the tangent poses
@@ -539,21 +551,9 @@ const ON_TANGENT_TOLERANCE: f64 = 1e-12;
 /// is solved.
 fn dominated_samples(s: &Structure, failing: &[(Option<usize>, f64)]) -> Vec<bool> {
     let mut out = vec![false; failing.len()];
-    let Some(n) = s.hanging.first().map(|h| h.path.len()) else {
+    let Some(n) = sweep_bisection::samples(s) else {
         return out;
     };
-    let one_group = s
-        .hanging
-        .iter()
-        .all(|h| h.group == 0 && h.path.len() == n && h.hull.len() + 1 == n);
-    let tangents = s.between.len() + 1 == n
-        && s.between
-            .iter()
-            .enumerate()
-            .all(|(v, p)| p.as_slice() == [Point::Tangent(v)]);
-    if n < 3 || !one_group || !tangents {
-        return out;
-    }
     let mut present = vec![false; 2 * n - 1];
     for &(pose, _) in failing {
         if let Some(k) = pose.filter(|&k| k < present.len()) {
@@ -564,24 +564,7 @@ fn dominated_samples(s: &Structure, failing: &[(Option<usize>, f64)]) -> Vec<boo
         let Some(k) = pose.filter(|&k| k >= 1 && k + 1 < n) else {
             continue;
         };
-        if !(present[n + k - 1] && present[n + k]) {
-            continue;
-        }
-        // The one weight α with sample = b + α·(a − b), a and b the
-        // tangent points before and after it, least squares over movers.
-        let (mut num, mut den) = (0.0, 0.0);
-        for h in &s.hanging {
-            let (a, b, m) = (h.hull[k - 1], h.hull[k], h.path[k]);
-            num += (m - b).dot(a - b);
-            den += (a - b).length_squared();
-        }
-        let alpha = if den > 0.0 { num / den } else { 0.0 };
-        let on_segment = (0.0..=1.0).contains(&alpha)
-            && s.hanging.iter().all(|h| {
-                let (a, b, m) = (h.hull[k - 1], h.hull[k], h.path[k]);
-                (m - (b + alpha * (a - b))).length() <= ON_TANGENT_TOLERANCE
-            });
-        out[i] = on_segment;
+        out[i] = present[n + k - 1] && present[n + k] && sweep_bisection::between_tangents(s, k);
     }
     out
 }
@@ -1655,6 +1638,15 @@ impl Analyzer {
             bodies: &comps.bodies[c],
             links: &comps.links[c],
         };
+        if let Some((bisected, setting)) = self.bisect(s, part, failing) {
+            out.capacities = bisected.smallest;
+            out.lower = bisected.lower;
+            out.partial = bisected.partial;
+            out.runs = bisected.solves;
+            out.setting = setting;
+            self.rigid(s, part, failing, &mut out);
+            return out;
+        }
         // The poses' problems are independent: past the first (a failing
         // step usually fails there), they are solved in waves of as many
         // as there are threads, ahead of the sequential logic below, which
@@ -1760,15 +1752,26 @@ impl Analyzer {
             failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
         }
         out.setting = start;
-        // With rigid connectors the feasible forces include every one
-        // within capacities (the support rows are the same, and summing
-        // the bodies' balances cancels the internal links), so the rigid
-        // factor is at least the capacities' one. When every pose holds
-        // (solved, spared or bounded by the smallest, all ≥ 1), the
-        // component stands and no rigid solve is needed; only a failing
-        // component is asked whether it tips or slides, at every pose.
-        // A NaN (solver failure) sticks: it reads as overloaded everywhere.
-        // (A pose left out, `partial`, comes only after a failing one.)
+        self.rigid(s, part, failing, &mut out);
+        out
+    }
+
+    /// With rigid connectors the feasible forces include every one within
+    /// capacities (the support rows are the same, and summing the bodies'
+    /// balances cancels the internal links), so the rigid factor is at
+    /// least the capacities' one. When every pose holds (solved, spared or
+    /// bounded by the smallest, all ≥ 1), the component stands and no rigid
+    /// solve is needed; only a failing component is asked whether it tips
+    /// or slides, at every pose. A NaN (solver failure) sticks: it reads
+    /// as overloaded everywhere. (A pose left out, `partial`, comes only
+    /// after a failing one.)
+    fn rigid(
+        &self,
+        s: &Structure,
+        part: limit::Part<'_>,
+        failing: &[(Option<usize>, f64)],
+        out: &mut LimitOutcome,
+    ) {
         if out.capacities.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
             for &(pose, _) in failing {
                 let loads = body_loads(s, pose);
@@ -1778,7 +1781,80 @@ impl Analyzer {
                 out.rigid = lowest(out.rigid, rigid.lambda);
             }
         }
-        out
+    }
+
+    /// The smallest factor over the poses by [`sweep_bisection`], where
+    /// it applies: every pose of the sweep (its samples and the poses
+    /// between them, [`sweep_bisection::sweep`]) failing the screen; a
+    /// load-factor tolerance spares runs too (its bound then the lower
+    /// end).
+    /// The first solve runs alone, to learn the solver setting the others
+    /// start from ([`limit::load_factor_from`]); the rest of each batch
+    /// the bisection asks for run in parallel.
+    fn bisect(
+        &self,
+        s: &Structure,
+        part: limit::Part<'_>,
+        failing: &[(Option<usize>, f64)],
+    ) -> Option<(sweep_bisection::Outcome, usize)> {
+        if !self.settings.bisect_sweeps {
+            return None;
+        }
+        let sweep = sweep_bisection::sweep(s)?;
+        let mut present = vec![false; s.hanging[0].path.len() + s.between.len()];
+        for &(pose, _) in failing {
+            if let Some(k) = pose.filter(|&k| k < present.len()) {
+                present[k] = true;
+            }
+        }
+        if !present.iter().all(|&p| p) {
+            return None;
+        }
+        let mut start = self.limit_setting;
+        let mut first = true;
+        let model = &self.model;
+        let factor = |corner: &sweep_bisection::Corner, start: usize| {
+            let loads = match corner {
+                sweep_bisection::Corner::Pose(k) => body_loads(s, Some(*k)),
+                sweep_bisection::Corner::Centres(centres) => body_loads_at(s, centres),
+            };
+            limit::load_factor_from(s, model, &loads, part, Connectors::Capacities, start)
+        };
+        let mut solve = |corners: &[sweep_bisection::Corner]| -> Vec<f64> {
+            let mut values = Vec::with_capacity(corners.len());
+            let mut rest = corners;
+            if first && let Some((c, tail)) = corners.split_first() {
+                let r = factor(c, start);
+                if r.setting < limit::SETTINGS.len() {
+                    start = r.setting;
+                }
+                first = false;
+                values.push(r.lambda);
+                rest = tail;
+            }
+            let start = start;
+            values.extend(
+                rest.par_iter()
+                    .map(|c| factor(c, start).lambda)
+                    .collect::<Vec<_>>(),
+            );
+            values
+        };
+        // Each pose's elastic bound of 1/λ: a lower end for the runs a
+        // failing step leaves open.
+        let mut elastic = vec![0.0; present.len()];
+        for &(pose, bound) in failing {
+            if let Some(k) = pose.filter(|&k| k < elastic.len())
+                && bound.is_finite()
+                && bound > 0.0
+            {
+                elastic[k] = 1.0 / bound;
+            }
+        }
+        let floor = |k: usize| elastic[k];
+        let tolerance = self.settings.load_factor_tolerance;
+        let outcome = sweep_bisection::smallest_factor(s, &sweep, &mut solve, &floor, tolerance);
+        Some((outcome, start))
     }
 
     /// The bound by which the fields solved so far prove that `pose`

@@ -15,7 +15,9 @@
 //! * `closed_form` — the cantilever bounds the study is checked against;
 //! * `limit`, `proof` — the limit analysis (lower-bound theorem) and the
 //!   proof of its factor; `pose_hull` — a few points holding a step's
-//!   poses, where a region's bound is proved once for all of them.
+//!   poses, where a region's bound is proved once for all of them;
+//!   `sweep_bisection` — a sweep's smallest factor by branch and bound
+//!   along the movers' path, bounding runs of poses by one triangle each.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
@@ -30,6 +32,7 @@ pub(crate) mod pose_hull;
 pub(crate) mod reuse;
 pub(crate) mod solver;
 pub(crate) mod structure;
+pub(crate) mod sweep_bisection;
 
 pub use analysis::{Analysis, Analyzer, Critical, LinkResult, Verdict};
 pub use capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};

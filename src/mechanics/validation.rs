@@ -692,7 +692,9 @@ fn wall_swing(n: i32, to: Cell, mirror: bool, resting: bool) -> Structure {
 #[test]
 fn a_sample_between_its_tangent_poses_is_not_solved_and_the_factor_is_still_every_poses_smallest() {
     let model = Model::default_catom();
-    let analyse = |s: &Structure| Analyzer::new(model.clone(), false).analyse(s);
+    // Every pose but the dominated samples (the bisection, on by default,
+    // passes over more: tested below).
+    let analyse = |s: &Structure| bisected(&model, s, false);
     let cases = [
         (7, Cell::new(7, 1, 1), false),
         (8, Cell::new(8, 0, 2), false),
@@ -750,12 +752,272 @@ fn a_sample_between_its_tangent_poses_is_not_solved_and_the_factor_is_still_ever
     }
 }
 
+/// The analysis of `s`, its sweeps bisected or not
+/// (`Settings::bisect_sweeps`).
+fn bisected(model: &Model, s: &Structure, bisect: bool) -> super::analysis::Analysis {
+    let mut a = Analyzer::new(model.clone(), false);
+    a.settings.bisect_sweeps = bisect;
+    a.analyse(s)
+}
+
+/// Each pose of a sweep alone: its factor by the limit analysis, the mover
+/// centred at `c` (no path beyond it).
+fn factor_alone(model: &Model, s: &Structure, c: DVec3) -> f64 {
+    let mut one = s.clone();
+    one.hanging[0].path = vec![c];
+    one.hanging[0].hull.clear();
+    one.between.clear();
+    let b = Analyzer::new(model.clone(), false).analyse(&one);
+    assert_eq!(b.limit_analyses, 1);
+    b.load_factor.expect("judged by the limit analysis")
+}
+
+/// The bisection of a sweep (`sweep_bisection`) reports the smallest
+/// factor over its 49 poses, each enumerated here by its own analysis,
+/// within the proofs' round-off (each factor is proved from the solver's
+/// equilibrium, a little under the optimum; neighbouring poses' proofs
+/// scatter by up to 1e-5 of the factor), on a fixed root (mirrored too)
+/// and resting on the ground, with fewer analyses than every pose; and
+/// where the sweep fails, the same verdict and a lower end no higher than
+/// any pose's factor.
+#[test]
+fn a_bisected_sweep_reports_every_poses_smallest_factor_from_fewer_analyses() {
+    let model = Model::default_catom();
+    let analyse = |s: &Structure, bisect: bool| bisected(&model, s, bisect);
+    let cases = [
+        (7, Cell::new(7, 1, 1), false),
+        (8, Cell::new(8, 0, 2), false),
+        (3, Cell::new(3, 1, 1), true),
+        (4, Cell::new(4, 0, 2), true),
+    ];
+    let (mut bisected, mut every_pose) = (0, 0);
+    for (n, to, resting) in cases {
+        for mirror in [false, true].into_iter().filter(|&m| !(m && resting)) {
+            let s = wall_swing(n, to, mirror, resting);
+            let case = format!("{n} {to:?} {resting} {mirror}");
+            let (a, full) = (analyse(&s, true), analyse(&s, false));
+            let lambda = a.load_factor.expect("judged by the limit analysis");
+            let h = &s.hanging[0];
+            assert_eq!((h.path.len(), a.between_poses), (25, 24), "{case}");
+            let every = h
+                .path
+                .iter()
+                .chain(&h.hull)
+                .map(|&c| factor_alone(&model, &s, c))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                lambda <= every * (1.0 + 1e-5) && every <= lambda * (1.0 + 1e-5),
+                "{case}: {lambda} against {every}"
+            );
+            assert_eq!(a.verdict(), full.verdict(), "{case}");
+            assert!(a.limit_analyses <= full.limit_analyses, "{case}");
+            bisected += a.limit_analyses;
+            every_pose += full.limit_analyses;
+        }
+    }
+    assert!(2 * bisected < every_pose, "{bisected} against {every_pose}");
+    // A cantilever too long to hold: the same verdict, and the lower end
+    // of the factor no higher than any pose's.
+    let s = wall_swing(14, Cell::new(14, 1, 1), false, false);
+    let (a, full) = (analyse(&s, true), analyse(&s, false));
+    assert_eq!(a.verdict(), Verdict::Overloaded);
+    assert_eq!(full.verdict(), Verdict::Overloaded);
+    let h = &s.hanging[0];
+    let every = h
+        .path
+        .iter()
+        .chain(&h.hull)
+        .map(|&c| factor_alone(&model, &s, c))
+        .fold(f64::INFINITY, f64::min);
+    let lower = a.load_factor_lower.or(a.load_factor).unwrap();
+    assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
+    assert!(a.load_factor.unwrap() < 1.0);
+}
+
+/// [`wall_swing`]'s wall with a mover onto its top at each end, turning
+/// the other way round: two groups of movers, so 7 poses between each two
+/// samples (`Structure::between`).
+fn two_group_swing(n: i32, resting: bool) -> Structure {
+    let mut cells: Vec<Cell> = (0..2)
+        .flat_map(|z| (0..=n).map(move |x| Cell::new(x, 0, z)))
+        .collect();
+    let (far, near) = (Cell::new(n + 1, 0, 1), Cell::new(-1, 0, 1));
+    cells.push(far);
+    cells.push(near);
+    let movers: Vec<MoverSpec> = vec![
+        (
+            cells.len() as ModuleId - 1,
+            Some(2 * n as ModuleId + 2),
+            Motion::Rotate {
+                from: far,
+                to: Cell::new(n, 0, 2),
+                pivot: Cell::new(n, 0, 1),
+                route: Route::Octagonal,
+            },
+        ),
+        (
+            cells.len() as ModuleId,
+            Some(n as ModuleId + 2),
+            Motion::Rotate {
+                from: near,
+                to: Cell::new(0, 0, 2),
+                pivot: Cell::new(0, 0, 1),
+                route: Route::Octagonal,
+            },
+        ),
+    ];
+    if resting {
+        cells.extend((0..=n).map(|x| Cell::new(x, -1, 0)));
+        structure(&FccLattice, Some(Ground { layer: 0 }), &cells, &[], &movers)
+    } else {
+        structure(&FccLattice, None, &cells, &[0], &movers)
+    }
+}
+
+/// Two groups of movers: the bisection bounds each run by the product of
+/// the groups' triangles (9 corners) and reports the factor the analysis
+/// of every pose (25 samples and 168 poses between them) finds, within
+/// the proofs' round-off, with the same verdict and fewer analyses (158
+/// against 193 on the cantilever, whose factor varies by 1 % along the
+/// sweep; the wall resting on the ground clears some poses elastically,
+/// so both solve the same 169 poses).
+#[test]
+fn a_bisected_sweep_of_two_groups_reports_the_smallest_factor_of_every_pose() {
+    let model = Model::default_catom();
+    let analyse = |s: &Structure, bisect: bool| bisected(&model, s, bisect);
+    for (n, resting) in [(7, false), (3, true)] {
+        let s = two_group_swing(n, resting);
+        let w = super::sweep_bisection::sweep(&s).expect("two groups, 25 samples");
+        assert_eq!(
+            (w.n, w.groups, w.per_interval, s.between.len()),
+            (25, 2, 7, 168)
+        );
+        let (a, full) = (analyse(&s, true), analyse(&s, false));
+        let (lambda, every) = (a.load_factor.unwrap(), full.load_factor.unwrap());
+        assert!(
+            lambda <= every * (1.0 + 1e-5) && every <= lambda * (1.0 + 1e-5),
+            "{n} {resting}: {lambda} against {every}"
+        );
+        assert_eq!(a.verdict(), full.verdict());
+        // Bisected only where every pose failed the screen.
+        let every_pose = full.limit_analyses == 193;
+        assert_eq!(every_pose, !resting, "{}", full.limit_analyses);
+        assert!(
+            (a.limit_analyses < full.limit_analyses) == every_pose,
+            "{n} {resting}: {} against {}",
+            a.limit_analyses,
+            full.limit_analyses
+        );
+    }
+}
+
+/// The bisection against an enumeration of the 49 poses of a real sweep,
+/// with factors given in closed form: `1/λ = a + |M(c − c₀)|`, a convex
+/// gauge of the mover's centre `c`, as the limit analysis's is. The
+/// reported factor is never above the smallest pose's and at most the
+/// pruning slack (1e-7) under it; a flat factor takes 3 analyses; a
+/// minimum inside the sweep is found; a failing sweep reports a lower end
+/// no higher than the smallest; a failed solve (NaN) sticks.
+#[test]
+fn the_sweep_bisection_finds_the_smallest_of_convex_factors_against_an_enumeration() {
+    use super::sweep_bisection::{Corner, smallest_factor, sweep};
+    use glam::DMat3;
+    let s = wall_swing(7, Cell::new(7, 1, 1), false, false);
+    let w = sweep(&s).expect("one mover, 25 samples, 24 tangent poses");
+    assert_eq!((w.n, w.groups, w.per_interval), (25, 1, 1));
+    let n = w.n;
+    let pivot = s.bodies[s.hanging[0].pivot].centre;
+    let middle = s.hanging[0].path[12] - pivot;
+    let run_within = |gauge: &dyn Fn(DVec3) -> f64, nan_at: Option<usize>, tolerance: f64| {
+        let exact = (0..2 * n - 1)
+            .map(|k| 1.0 / gauge(s.mover_point(0, k)))
+            .fold(f64::INFINITY, f64::min);
+        let mut solve = |corners: &[Corner]| -> Vec<f64> {
+            corners
+                .iter()
+                .map(|c| match c {
+                    Corner::Pose(k) if Some(*k) == nan_at => f64::NAN,
+                    Corner::Pose(k) => 1.0 / gauge(s.mover_point(0, *k)),
+                    Corner::Centres(t) => 1.0 / gauge(t[0]),
+                })
+                .collect()
+        };
+        (
+            smallest_factor(&s, &w, &mut solve, &|_| 0.0, tolerance),
+            exact,
+        )
+    };
+    let run = |gauge: &dyn Fn(DVec3) -> f64, nan_at: Option<usize>| run_within(gauge, nan_at, 0.0);
+    let stretch = DMat3::from_diagonal(DVec3::new(1.0, 3.0, 0.5));
+    type Gauge<'a> = Box<dyn Fn(DVec3) -> f64 + 'a>;
+    let cases: Vec<(&str, Gauge)> = vec![
+        ("flat", Box::new(|_| 0.2)),
+        (
+            "tilted",
+            Box::new(|c: DVec3| 0.1 + 0.01 * (c - pivot).x.abs()),
+        ),
+        (
+            "peaked inside",
+            Box::new(move |c: DVec3| {
+                0.05 + 0.02 * (stretch * (c - (pivot - 3.0 * middle))).length()
+            }),
+        ),
+        (
+            "round",
+            Box::new(move |c: DVec3| 0.1 + 0.03 * (c - (pivot - middle)).length()),
+        ),
+    ];
+    for (name, gauge) in &cases {
+        let (o, exact) = run(gauge.as_ref(), None);
+        assert!(
+            o.smallest <= exact && o.smallest >= exact * (1.0 - 1e-7),
+            "{name}: {} against {exact}",
+            o.smallest
+        );
+        assert!(!o.partial && o.lower == o.smallest, "{name}");
+        assert!(o.solves < 2 * n - 1, "{name}: {} analyses", o.solves);
+        if *name == "flat" {
+            assert_eq!(o.solves, 3);
+        }
+    }
+    // The interior minimum is a tangent pose near the middle, found.
+    let (o, exact) = run(cases[2].1.as_ref(), None);
+    let at = o.poses.iter().find(|(_, v)| *v == exact).map(|(k, _)| *k);
+    assert!(at.is_some_and(|k| k > n && k < 2 * n - 2), "{at:?}");
+    // Failing inside the sweep: below 1, and the lower end no higher.
+    let failing = |c: DVec3| 0.5 + 0.5 * (stretch * (c - (pivot - 3.0 * middle))).length();
+    let (o, exact) = run(&failing, None);
+    assert!(
+        exact < 1.0 && o.smallest < 1.0 && o.lower <= exact,
+        "{o:?} {exact}"
+    );
+    // A failed solve sticks.
+    let (o, _) = run(cases[3].1.as_ref(), Some(12));
+    assert!(o.smallest.is_nan(), "{o:?}");
+    // A load-factor tolerance spares runs within it: fewer analyses, and
+    // the exact smallest within [lower, smallest], lower at most the
+    // tolerance under the factor.
+    let (exact_run, exact) = run(cases[2].1.as_ref(), None);
+    let (o, _) = run_within(cases[2].1.as_ref(), None, 0.05);
+    assert!(
+        o.solves < exact_run.solves,
+        "{} against {}",
+        o.solves,
+        exact_run.solves
+    );
+    assert!(o.lower <= exact && exact <= o.smallest, "{o:?} {exact}");
+    assert!(o.lower >= 0.95 * o.smallest, "{o:?}");
+}
+
 #[test]
 fn a_load_factor_tolerance_skips_poses_within_its_bound_whatever_the_threads() {
     let model = Model::default_catom();
     let on = |threads: usize, s: &Structure, tolerance: f64| {
         let mut a = Analyzer::new(model.clone(), false);
         a.settings.load_factor_tolerance = tolerance;
+        // Exact against every pose (the bisection, which applies only
+        // without a tolerance, is tested above).
+        a.settings.bisect_sweeps = false;
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()

@@ -68,7 +68,7 @@ pub struct Row {
     /// as holding. 0 when every step's bound was finite or judged.
     #[serde(default)]
     pub equilibria_unproved: usize,
-    /// Bounded steps taken up by [`prove_worst`] (a region's bound, and the
+    /// Bounded steps taken up by `prove_worst` (a region's bound, and the
     /// full limit analysis where that stays above the worst): where a
     /// worst-only study's time went.
     #[serde(default)]
@@ -146,7 +146,7 @@ pub struct Study {
 pub enum Judging {
     /// Every step the elastic screen cannot clear, in its range.
     Every,
-    /// Only the steps that could be a row's worst ([`prove_worst`]): the
+    /// Only the steps that could be a row's worst (`prove_worst`): the
     /// rows are those of judging every step.
     WorstOnly,
     /// As [`Judging::WorstOnly`], but a row proved to fail (a step judged
@@ -162,7 +162,7 @@ pub enum Judging {
 }
 
 impl Judging {
-    /// The ranges run with the limit analysis off; [`prove_worst`] judges.
+    /// The ranges run with the limit analysis off; `prove_worst` judges.
     fn bounds_only(self) -> bool {
         self != Judging::Every
     }
@@ -419,7 +419,7 @@ pub fn on_threads(
 /// [`Judging::WorstOnly`]: a row needs the exact utilisation of its worst
 /// step, not of every step. The ranges then run with the limit analysis
 /// off, so a step the elastic screen cannot clear gets an upper bound of
-/// its utilisation (`Settings::limit_analysis`); [`prove_worst`] then
+/// its utilisation (`Settings::limit_analysis`); `prove_worst` then
 /// judges steps from the highest bound down, until no bound left exceeds
 /// the worst utilisation proved. The rows' verdicts, maxima and pressures
 /// are those of judging every step; `limit_analyses` and `steps_bounded`
@@ -541,7 +541,7 @@ pub fn study_rows(
     Ok(Some((rows, unplanned, first_error)))
 }
 
-/// Steps judged together in [`prove_worst`]: a fixed number, so that which
+/// Steps judged together in `prove_worst`: a fixed number, so that which
 /// steps are judged does not depend on the threads.
 const PROVED_TOGETHER: usize = 4;
 
