@@ -752,6 +752,17 @@ fn a_sample_between_its_tangent_poses_is_not_solved_and_the_factor_is_still_ever
     }
 }
 
+/// The smallest factor over the poses of `s`'s one mover (its samples
+/// and tangent points), each analysed alone.
+fn smallest_alone(model: &Model, s: &Structure) -> f64 {
+    let h = &s.hanging[0];
+    h.path
+        .iter()
+        .chain(&h.hull)
+        .map(|&c| factor_alone(model, s, c))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The analysis of `s`, its sweeps bisected or not
 /// (`Settings::bisect_sweeps`).
 fn bisected(model: &Model, s: &Structure, bisect: bool) -> super::analysis::Analysis {
@@ -797,14 +808,12 @@ fn a_bisected_sweep_reports_every_poses_smallest_factor_from_fewer_analyses() {
             let case = format!("{n} {to:?} {resting} {mirror}");
             let (a, full) = (analyse(&s, true), analyse(&s, false));
             let lambda = a.load_factor.expect("judged by the limit analysis");
-            let h = &s.hanging[0];
-            assert_eq!((h.path.len(), a.between_poses), (25, 24), "{case}");
-            let every = h
-                .path
-                .iter()
-                .chain(&h.hull)
-                .map(|&c| factor_alone(&model, &s, c))
-                .fold(f64::INFINITY, f64::min);
+            assert_eq!(
+                (s.hanging[0].path.len(), a.between_poses),
+                (25, 24),
+                "{case}"
+            );
+            let every = smallest_alone(&model, &s);
             assert!(
                 lambda <= every * (1.0 + 1e-5) && every <= lambda * (1.0 + 1e-5),
                 "{case}: {lambda} against {every}"
@@ -822,13 +831,7 @@ fn a_bisected_sweep_reports_every_poses_smallest_factor_from_fewer_analyses() {
     let (a, full) = (analyse(&s, true), analyse(&s, false));
     assert_eq!(a.verdict(), Verdict::Overloaded);
     assert_eq!(full.verdict(), Verdict::Overloaded);
-    let h = &s.hanging[0];
-    let every = h
-        .path
-        .iter()
-        .chain(&h.hull)
-        .map(|&c| factor_alone(&model, &s, c))
-        .fold(f64::INFINITY, f64::min);
+    let every = smallest_alone(&model, &s);
     let lower = a.load_factor_lower.or(a.load_factor).unwrap();
     assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
     assert!(a.load_factor.unwrap() < 1.0);
