@@ -13,7 +13,7 @@ use super::capacity::{
     utilisation,
 };
 use super::direct::Factor;
-use super::limit::{self, Connectors};
+use super::limit::{self, Connectors, fails, lowest};
 use super::model::{Capacity, Model};
 use super::pose_hull;
 use super::reuse::KeptFactor;
@@ -567,16 +567,6 @@ fn dominated_samples(s: &Structure, failing: &[(Option<usize>, f64)]) -> Vec<boo
         out[i] = present[n + k - 1] && present[n + k] && sweep_bisection::between_tangents(s, k);
     }
     out
-}
-
-/// The smaller factor; a NaN (a failed solve) sticks, so that it reads as
-/// overloaded wherever it ends up.
-fn lowest(x: f64, y: f64) -> f64 {
-    if x.is_nan() || y.is_nan() {
-        f64::NAN
-    } else {
-        x.min(y)
-    }
 }
 
 /// Mover `h`'s moment on its pivot (units `W·d`) at sample `pose` of its
@@ -1749,7 +1739,7 @@ impl Analyzer {
             out.runs += 1;
             out.capacities = lowest(out.capacities, cap.lambda);
             out.lower = lowest(out.lower, cap.lambda);
-            failed = cap.lambda.partial_cmp(&1.0).is_none_or(|o| o.is_lt());
+            failed = fails(cap.lambda);
         }
         out.setting = start;
         self.rigid(s, part, failing, &mut out);
@@ -1772,7 +1762,7 @@ impl Analyzer {
         failing: &[(Option<usize>, f64)],
         out: &mut LimitOutcome,
     ) {
-        if out.capacities.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
+        if fails(out.capacities) {
             for &(pose, _) in failing {
                 let loads = body_loads(s, pose);
                 let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
@@ -1788,6 +1778,7 @@ impl Analyzer {
     /// between them, [`sweep_bisection::sweep`]) failing the screen; a
     /// load-factor tolerance spares runs too (its bound then the lower
     /// end).
+    ///
     /// The first solve runs alone, to learn the solver setting the others
     /// start from ([`limit::load_factor_from`]); the rest of each batch
     /// the bisection asks for run in parallel.
@@ -1801,15 +1792,16 @@ impl Analyzer {
             return None;
         }
         let sweep = sweep_bisection::sweep(s)?;
-        let mut present = vec![false; s.hanging[0].path.len() + s.between.len()];
-        for &(pose, _) in failing {
-            if let Some(k) = pose.filter(|&k| k < present.len()) {
-                present[k] = true;
+        // Each failing pose's elastic bound of 1/λ as a factor (0 without
+        // one): a lower end for the runs a failing step leaves open.
+        let mut elastic = vec![None; sweep.n + s.between.len()];
+        for &(pose, bound) in failing {
+            if let Some(k) = pose.filter(|&k| k < elastic.len()) {
+                let known = bound.is_finite() && bound > 0.0;
+                elastic[k] = Some(if known { 1.0 / bound } else { 0.0 });
             }
         }
-        if !present.iter().all(|&p| p) {
-            return None;
-        }
+        let elastic: Vec<f64> = elastic.into_iter().collect::<Option<_>>()?;
         let mut start = self.limit_setting;
         let mut first = true;
         let model = &self.model;
@@ -1840,17 +1832,6 @@ impl Analyzer {
             );
             values
         };
-        // Each pose's elastic bound of 1/λ: a lower end for the runs a
-        // failing step leaves open.
-        let mut elastic = vec![0.0; present.len()];
-        for &(pose, bound) in failing {
-            if let Some(k) = pose.filter(|&k| k < elastic.len())
-                && bound.is_finite()
-                && bound > 0.0
-            {
-                elastic[k] = 1.0 / bound;
-            }
-        }
         let floor = |k: usize| elastic[k];
         let tolerance = self.settings.load_factor_tolerance;
         let outcome = sweep_bisection::smallest_factor(s, &sweep, &mut solve, &floor, tolerance);
@@ -1997,7 +1978,7 @@ impl Analyzer {
             out.load_factor_partial |= l.partial;
             let lower = lowest(l.lower, l.capacities);
             out.load_factor_lower = Some(out.load_factor_lower.map_or(lower, |x| lowest(x, lower)));
-            if l.rigid.partial_cmp(&1.0).is_none_or(|o| o.is_lt()) {
+            if fails(l.rigid) {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.
                 no_equilibrium = true;

@@ -48,6 +48,21 @@ use proof::EQUILIBRIUM_TOL;
 /// weight, and the LP would be unbounded).
 pub const LAMBDA_CAP: f64 = 1e4;
 
+/// The smaller factor; a NaN (a failed solve) sticks, so that it reads as
+/// overloaded wherever it ends up.
+pub fn lowest(x: f64, y: f64) -> f64 {
+    if x.is_nan() || y.is_nan() {
+        f64::NAN
+    } else {
+        x.min(y)
+    }
+}
+
+/// A factor below 1, or NaN (a failed solve): the structure does not hold.
+pub fn fails(x: f64) -> bool {
+    x.partial_cmp(&1.0).is_none_or(|o| o.is_lt())
+}
+
 /// Which capacities bind.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Connectors {

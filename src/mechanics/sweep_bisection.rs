@@ -27,6 +27,7 @@
 //! smoothly along the sweep (a corner that is no pose is solved too, but
 //! only bounds).
 
+use super::limit::{fails, lowest};
 use super::structure::{Point, Structure};
 use glam::DVec3;
 
@@ -149,20 +150,6 @@ pub fn between_tangents(s: &Structure, k: usize) -> bool {
             let (a, b, m) = (h.hull[k - 1], h.hull[k], h.path[k]);
             (m - (b + alpha * (a - b))).length() <= INSIDE_TOLERANCE
         })
-}
-
-/// The smaller factor; a NaN (a failed solve) sticks.
-fn lowest(x: f64, y: f64) -> f64 {
-    if x.is_nan() || y.is_nan() {
-        f64::NAN
-    } else {
-        x.min(y)
-    }
-}
-
-/// Below 1, or NaN: the step fails.
-fn fails(x: f64) -> bool {
-    x.partial_cmp(&1.0).is_none_or(|o| o.is_lt())
 }
 
 /// The apexes of samples `i … j` (`j ≥ i + 2`): per mover, where the line
@@ -374,7 +361,8 @@ pub fn smallest_factor(
         }
     }
     out.smallest = lowest(out.smallest, pruned);
-    out.partial = !open.is_empty() && !runs.is_empty();
+    // Runs stay open only when a failing pose ended the search.
+    out.partial = !open.is_empty();
     if out.partial {
         for (i, j, b) in open {
             let poses = (i..=j).chain((i * w.per_interval..j * w.per_interval).map(|v| n + v));
