@@ -20,8 +20,8 @@ pub struct Args {
     /// tunnel-contracted-both-legs. Default: all of them.
     #[arg(long = "move", value_name = "NAME")]
     moves: Vec<String>,
-    /// The folder to write the files to (default: the repository's
-    /// models/moves, relative to the current directory).
+    /// The folder to write the files to, made if missing (default: the
+    /// repository's models/moves, relative to the current directory).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
@@ -45,6 +45,14 @@ pub fn run(a: Args) -> Result<u8, Error> {
         chosen = StoredId::ALL.to_vec();
     }
     let dir = a.out.unwrap_or_else(|| PathBuf::from("models/moves"));
+    // The folder is made before the searches (a minute each), so a path
+    // that cannot be one fails at once rather than after them.
+    if !a.check {
+        std::fs::create_dir_all(&dir).map_err(|source| Error::Write {
+            path: dir.clone(),
+            source,
+        })?;
+    }
     let mut differ = 0;
     for id in chosen {
         eprintln!(

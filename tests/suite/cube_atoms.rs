@@ -630,6 +630,27 @@ fn derive_moves_refuses_an_unknown_move_naming_the_known_ones() {
     );
 }
 
+/// `derive-moves --out` makes a missing folder, and one that cannot be a
+/// folder (a file stands in its path) fails at once (exit 3, naming it),
+/// not after the searches.
+#[test]
+fn derive_moves_makes_its_output_folder_or_fails_before_searching() {
+    let file = common::scratch("derive-out", "a-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let out = file.join("moves");
+    let o = common::bin()
+        .args(["derive-moves", "--move", "slide-expanded", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains(&out.display().to_string()) && !err.contains("searching"),
+        "{err}"
+    );
+}
+
 #[test]
 fn tunnels_other_than_the_derived_one_are_refused_naming_the_reason() {
     let (metas, _) = tunnel_robot(|c| c);
