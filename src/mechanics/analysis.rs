@@ -1773,11 +1773,12 @@ impl Analyzer {
         }
     }
 
-    /// The smallest factor over the poses by [`sweep_bisection`], where
-    /// it applies: every pose of the sweep (its samples and the poses
-    /// between them, [`sweep_bisection::sweep`]) failing the screen; a
-    /// load-factor tolerance spares runs too (its bound then the lower
-    /// end).
+    /// The smallest factor over the failing poses by [`sweep_bisection`],
+    /// where it applies: a sweep ([`sweep_bisection::sweep`]) at least
+    /// half of whose poses (its samples and the poses between them) fail
+    /// the screen; the poses it cleared are solved only as corners of a
+    /// run's bound. A load-factor tolerance spares runs too (its bound
+    /// then the lower end).
     ///
     /// The first solve runs alone, to learn the solver setting the others
     /// start from ([`limit::load_factor_from`]); the rest of each batch
@@ -1801,7 +1802,12 @@ impl Analyzer {
                 elastic[k] = Some(if known { 1.0 / bound } else { 0.0 });
             }
         }
-        let elastic: Vec<f64> = elastic.into_iter().collect::<Option<_>>()?;
+        // Where few poses fail, solving them (the enumeration, with its
+        // elastic bounds) costs less than the bisection's corners.
+        let wanted = elastic.iter().filter(|e| e.is_some()).count();
+        if 2 * wanted < elastic.len() {
+            return None;
+        }
         let mut start = self.limit_setting;
         let mut first = true;
         let model = &self.model;
