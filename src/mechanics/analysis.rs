@@ -1794,7 +1794,8 @@ impl Analyzer {
         }
         let sweep = sweep_bisection::sweep(s)?;
         // Each failing pose's elastic bound of 1/λ as a factor (0 without
-        // one): a lower end for the runs a failing step leaves open.
+        // one): a lower end for the runs a failing step leaves open. A
+        // pose the screen cleared stays None: not wanted.
         let mut elastic = vec![None; sweep.n + s.between.len()];
         for &(pose, bound) in failing {
             if let Some(k) = pose.filter(|&k| k < elastic.len()) {

@@ -55,19 +55,20 @@ pub enum Corner {
 /// The bisection's result.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Outcome {
-    /// The smallest factor over the poses (NaN: a solve failed): the
-    /// smallest solved, or a passed-over run's bound where lower (see
+    /// The smallest factor over the wanted poses (NaN: a solve failed):
+    /// the smallest solved, or a passed-over run's bound where lower (see
     /// [`PRUNE_SLACK`]).
     pub smallest: f64,
-    /// A proved lower bound of the smallest over every pose: `smallest`
-    /// itself unless `partial`.
+    /// A proved lower bound of the smallest over every wanted pose:
+    /// `smallest` itself unless `partial`.
     pub lower: f64,
     /// The step failed (a pose below 1) while runs were left unresolved:
     /// their poses may lie lower than `smallest`, but not below `lower`.
     pub partial: bool,
     /// Limit analyses taken: poses and other corners.
     pub solves: usize,
-    /// The poses solved, with their factors (other corners left out).
+    /// The wanted poses solved, with their factors (other corners, and
+    /// poses solved only as corners, left out).
     pub poses: Vec<(usize, f64)>,
 }
 
@@ -393,8 +394,8 @@ fn run_couplings(
 /// bound counting only towards `lower` (the factor is then within
 /// `[lower, smallest]`, as `--load-factor-tolerance` promises). Once a
 /// pose fails, the runs still open are left, and their bounds make
-/// `lower`: the larger of the run's bound and its wanted poses' smallest
-/// floor.
+/// `lower`: the smallest, over each such run's wanted poses, of the best
+/// bound known of the pose (its floor, or a hull's where higher).
 pub fn smallest_factor(
     s: &Structure,
     w: &Sweep,
