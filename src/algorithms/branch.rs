@@ -77,7 +77,7 @@ pub fn branch_schedule(b: usize, spacing_mm: f64) -> Result<Schedule, InputError
             });
         }
         let tip = Cell::new(k, 0, 0);
-        debug_assert_eq!(l.neighbour(tip, 4), Cell::new(k, 0, 1));
+        assert_eq!(l.neighbour(tip, 4), Cell::new(k, 0, 1));
         s.steps.push(Step {
             events: vec![Event::Rotate {
                 module: agent,

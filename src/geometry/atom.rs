@@ -37,14 +37,17 @@ pub fn bond_offset(f: Face, ext_a: &Faces, ext_b: &Faces) -> Cell {
 pub fn contact_face(pa: Cell, ea: &Faces, pb: Cell, eb: &Faces) -> Option<Face> {
     let d = pb - pa;
     let axis = [d.x, d.y, d.z];
-    let nonzero: Vec<usize> = (0..3).filter(|&i| axis[i] != 0).collect();
-    if nonzero.len() != 1 {
+    let mut nonzero = (0..3).filter(|&i| axis[i] != 0);
+    let (Some(i), None) = (nonzero.next(), nonzero.next()) else {
         return None;
-    }
-    let i = nonzero[0];
+    };
     let f = Face::of(i, axis[i].signum());
     (bond_offset(f, ea, eb) == d).then_some(f)
 }
+
+/// An atom's body and its extended arms as moving boxes (at most 1 + 6),
+/// inline: collision searches build them for every atom of every step.
+pub type AtomBoxes = arrayvec::ArrayVec<(Option<Face>, MovingBox), 7>;
 
 /// An axis-aligned box whose bounds move linearly over `s ∈ [0, 1]`.
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -76,7 +79,7 @@ impl MovingBox {
 
 /// The boxes of one atom over a step: the body, then one per face that is
 /// expanded at the start or at the end (arms of length 0 are left out).
-pub fn atom_boxes(p0: Cell, p1: Cell, e0: &Faces, e1: &Faces) -> Vec<(Option<Face>, MovingBox)> {
+pub fn atom_boxes(p0: Cell, p1: Cell, e0: &Faces, e1: &Faces) -> AtomBoxes {
     let c0 = [p0.x as f64, p0.y as f64, p0.z as f64];
     let c1 = [p1.x as f64, p1.y as f64, p1.z as f64];
     let body = |c: [f64; 3]| {
@@ -87,7 +90,8 @@ pub fn atom_boxes(p0: Cell, p1: Cell, e0: &Faces, e1: &Faces) -> Vec<(Option<Fac
     };
     let (lo0, hi0) = body(c0);
     let (lo1, hi1) = body(c1);
-    let mut out = vec![(None, MovingBox { lo0, hi0, lo1, hi1 })];
+    let mut out = AtomBoxes::new();
+    out.push((None, MovingBox { lo0, hi0, lo1, hi1 }));
     for f in Face::ALL {
         let (a, b) = (e0[f.index()], e1[f.index()]);
         if !a && !b {
@@ -125,11 +129,14 @@ pub fn first_overlap(a: &MovingBox, b: &MovingBox, eps: f64) -> Option<(f64, f64
     }
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
     // Overlap functions g(s) = c0 + s (c1 − c0) that must all exceed eps.
-    let mut gs: Vec<(f64, f64)> = Vec::with_capacity(6);
-    for i in 0..3 {
-        gs.push((a.hi0[i] - b.lo0[i], a.hi1[i] - b.lo1[i]));
-        gs.push((b.hi0[i] - a.lo0[i], b.hi1[i] - a.lo1[i]));
-    }
+    let gs: [(f64, f64); 6] = std::array::from_fn(|k| {
+        let i = k / 2;
+        if k % 2 == 0 {
+            (a.hi0[i] - b.lo0[i], a.hi1[i] - b.lo1[i])
+        } else {
+            (b.hi0[i] - a.lo0[i], b.hi1[i] - a.lo1[i])
+        }
+    });
     for &(c0, c1) in &gs {
         if !(c0.is_finite() && c1.is_finite()) {
             return Some((0.0, f64::NAN));

@@ -279,9 +279,33 @@ impl Scene {
         let boxes: Vec<_> = (0..self.pos.len())
             .map(|a| atom_boxes(self.pos[a], end[a], &self.ext[a], &ext1[a]))
             .collect();
+        // Each atom's sweep within one box: a pair whose boxes overlap by
+        // at most `eps` along some axis has no box pair that does, at any
+        // `s`, so `first_overlap` would clear it (cells are integers, the
+        // boxes finite; a tolerance that is no number is never screened).
+        let hulls: Vec<([f64; 3], [f64; 3])> = boxes
+            .iter()
+            .map(|bx| {
+                bx.iter().fold(
+                    ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+                    |(lo, hi), (_, b)| {
+                        let (l, h) = b.hull();
+                        (
+                            std::array::from_fn(|i| lo[i].min(l[i])),
+                            std::array::from_fn(|i| hi[i].max(h[i])),
+                        )
+                    },
+                )
+            })
+            .collect();
+        let screened = eps.is_finite() && eps >= 0.0;
+        let apart = |a: usize, b: usize| {
+            let ((la, ha), (lb, hb)) = (hulls[a], hulls[b]);
+            screened && (0..3).any(|i| ha[i].min(hb[i]) - la[i].max(lb[i]) <= eps)
+        };
         for &a in &active {
             for b in 0..self.pos.len() {
-                if b == a || (b < a && active.contains(&b)) {
+                if b == a || (b < a && active.contains(&b)) || apart(a, b) {
                     continue;
                 }
                 for (_, x) in &boxes[a] {

@@ -193,7 +193,7 @@ impl RunHull {
 /// with one set of weights (to [`INSIDE_TOLERANCE`]): then the run has no
 /// bound and is halved.
 pub fn hull(s: &Structure, i: usize, j: usize) -> Option<RunHull> {
-    debug_assert!(j >= i + 2);
+    assert!(j >= i + 2);
     let mut t = Vec::with_capacity(s.hanging.len());
     for h in &s.hanging {
         let (p1, d1) = (h.path[i], h.hull[i] - h.path[i]);

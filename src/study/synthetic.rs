@@ -92,7 +92,7 @@ pub fn islands_with_walkers(
             if let Some(&to) = targets.first() {
                 let n_f = (l.centre(from) - l.centre(pivot)).normalize();
                 let n_t = (l.centre(to) - l.centre(pivot)).normalize();
-                debug_assert!(fcc::rotation_axis(n_f, n_t, Route::Octagonal).is_some());
+                assert!(fcc::rotation_axis(n_f, n_t, Route::Octagonal).is_some());
                 let _ = (n_f, n_t);
                 events.push(Event::Rotate {
                     module: m,

@@ -414,7 +414,7 @@ pub fn reconfigure(source: &Shape, target: &Shape) -> Reconfiguration {
     s.to_common_comb(&u);
     let common_s = std::mem::take(&mut s.steps);
     t.to_common_comb(&u);
-    debug_assert_eq!(shape(&s), shape(&t), "one common comb");
+    assert_eq!(shape(&s), shape(&t), "one common comb");
     let ccs_t = std::mem::take(&mut t.steps);
     let (phase3, back_comb) = join_reversed(&mut s, &t, &t0, &comb_t, &after_comb_t, &ccs_t);
     Reconfiguration {

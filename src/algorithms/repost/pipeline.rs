@@ -220,7 +220,7 @@ pub fn pipeline(
         }
         spans.extend(span);
     }
-    debug_assert!(
+    assert!(
         (0..tl.moves.len()).all(|t| tl.anchored(t, None)),
         "every commit checks the steps its absence affects"
     );
