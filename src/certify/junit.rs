@@ -15,7 +15,9 @@ pub fn check_of(kind: ViolationKind) -> &'static str {
         ViolationKind::Collision
         | ViolationKind::SlidingContact
         | ViolationKind::GroundCollision => "collision",
-        ViolationKind::Unstable | ViolationKind::Overload => "mechanics",
+        ViolationKind::Unstable | ViolationKind::Overload | ViolationKind::JudgedAtSamples => {
+            "mechanics"
+        }
         ViolationKind::DockingBlocked => "docking",
         _ => "lattice",
     }

@@ -7,7 +7,7 @@
 //! the components the step changed, and warm-starts those from the
 //! displacements of their modules in the previous step.
 
-use super::report::{Violation, ViolationKind};
+use super::report::{Severity, Violation, ViolationKind};
 use super::{StepCheck, StepContext, StepOutcome, World};
 use crate::error::InputError;
 use crate::lattice::config::ModuleId;
@@ -215,6 +215,9 @@ pub fn critical_violation(
 }
 
 fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
+    if let Some(note) = judged_at_samples(step, a) {
+        out.warnings.push(note);
+    }
     out.metrics
         .insert("max_utilisation".into(), a.max_utilisation);
     if !a.pivots.is_empty() {
@@ -276,6 +279,27 @@ fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
                 .push(v.detail("unsupported_modules", loose.len()));
         }
     }
+}
+
+/// The note of a step whose analysis judged some component at the sampled
+/// poses alone (`Analysis::sampled_only`): the certificate then holds at
+/// those poses, not between them, and the report says so rather than
+/// passing the gap over in silence.
+fn judged_at_samples(step: usize, a: &Analysis) -> Option<Violation> {
+    let first = *a.sampled_only.iter().min()?;
+    let n = a.sampled_only.len();
+    Some(
+        Violation::new(
+            ViolationKind::JudgedAtSamples,
+            step,
+            format!(
+                "mechanics judged {n} component(s) at the sampled poses of the movers' sweeps only, not between them ({})",
+                first.describe()
+            ),
+        )
+        .severity(Severity::Note)
+        .detail("components", n),
+    )
 }
 
 impl StepCheck for LoadCheck {
@@ -795,5 +819,94 @@ mod tests {
         // A missing model file is unusable input, not a silent pass.
         s.model = Some("no-such-model.toml".into());
         assert!(certify(&s, &o).is_err());
+    }
+
+    /// A fixed floor, a free layer resting on it, and `k` agents on the
+    /// free layer, each rolling across its pivot's top in the one step:
+    /// `k` movers on one component.
+    fn agents_on_a_slab(k: usize) -> Schedule {
+        let l = FccLattice;
+        let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+        let mut id = 0;
+        let mut add = |s: &mut Schedule, cell: Cell, fixed: bool| {
+            id += 1;
+            s.modules.push(ModuleSpec { id, cell, fixed });
+            id
+        };
+        for x in 0..9 {
+            for y in 0..7 {
+                add(&mut s, Cell::new(x, y, 0), true);
+            }
+        }
+        let mut free = std::collections::HashMap::new();
+        for x in 0..8 {
+            for y in 0..6 {
+                free.insert((x, y), add(&mut s, Cell::new(x, y, 1), false));
+            }
+        }
+        let mut events = Vec::new();
+        for (x, y) in (0..6).flat_map(|y| [0, 2, 4, 6].map(|x| (x, y))).take(k) {
+            let pivot = Cell::new(x, y, 1);
+            let from = l.neighbour(pivot, 4);
+            let agent = add(&mut s, from, false);
+            events.push(Event::Rotate {
+                module: agent,
+                pivot: free[&(x, y)],
+                from,
+                to: l.neighbour(pivot, 5),
+                route: Route::Octagonal,
+            });
+        }
+        s.steps.push(Step { events });
+        s
+    }
+
+    #[test]
+    fn a_step_judged_at_its_samples_alone_is_noted_and_listed_as_not_checked() {
+        // 23 movers on one component, turning at one rate: superposed
+        // from unit moments (47 solves, against 25 samples and 24
+        // intervals), and the poses between samples judged. 24: solved
+        // pose by pose, judged at the samples alone, and the report says
+        // so.
+        let o = opts(Some("catom-3.6mm.toml"));
+        let r = certify(&agents_on_a_slab(23), &o).unwrap();
+        assert!(r.certified, "{}", r.summary());
+        assert!(
+            r.warnings
+                .iter()
+                .all(|w| w.kind != ViolationKind::JudgedAtSamples),
+            "{}",
+            r.summary()
+        );
+        assert!(r.coverage().1.is_empty(), "{:?}", r.coverage());
+        let r = certify(&agents_on_a_slab(24), &o).unwrap();
+        assert!(r.certified, "a note does not refuse: {}", r.summary());
+        let notes: Vec<_> = r
+            .warnings
+            .iter()
+            .filter(|w| w.kind == ViolationKind::JudgedAtSamples)
+            .collect();
+        assert_eq!(notes.len(), 1, "{}", r.summary());
+        assert_eq!((notes[0].step, notes[0].severity), (1, Severity::Note));
+        assert!(
+            notes[0].message.contains("24 movers"),
+            "{}",
+            notes[0].message
+        );
+        assert_eq!(notes[0].detail["components"], 1);
+        assert!(r.per_step[0].warnings >= 1);
+        let (_, not_checked) = r.coverage();
+        assert_eq!(
+            not_checked,
+            vec![
+                "mechanics between the sampled poses of the movers' sweeps at 1 step(s), from step 1 (judged_at_samples notes)"
+                    .to_string()
+            ]
+        );
+        assert!(
+            r.summary()
+                .contains("NOT checked: mechanics between the sampled poses")
+        );
+        assert!(r.to_json().contains("\"kind\": \"judged_at_samples\""));
     }
 }

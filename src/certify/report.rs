@@ -58,6 +58,10 @@ pub enum ViolationKind {
     /// is not static and occupied or whose exit is not free, or that turns
     /// more than 4 times.
     TunnelPrecondition,
+    /// A note: the mechanics judged a component at the sampled poses of
+    /// its movers' sweeps alone, so between samples its verdict is not
+    /// proved (`mechanics::analysis::SampledOnly` says why).
+    JudgedAtSamples,
 }
 
 impl ViolationKind {
@@ -72,6 +76,7 @@ impl ViolationKind {
                 | ViolationKind::DockingBlocked
                 | ViolationKind::Unstable
                 | ViolationKind::Overload
+                | ViolationKind::JudgedAtSamples
         )
     }
 
@@ -297,6 +302,18 @@ impl Report {
             } else {
                 "mechanics: not requested".to_string()
             });
+        }
+        let mut sampled = self
+            .warnings
+            .iter()
+            .filter(|w| w.kind == ViolationKind::JudgedAtSamples)
+            .map(|w| w.step);
+        if let Some(first) = sampled.next() {
+            not_checked.push(format!(
+                "mechanics between the sampled poses of the movers' sweeps at {} step(s), from step {first} ({} notes)",
+                1 + sampled.count(),
+                ViolationKind::JudgedAtSamples.name()
+            ));
         }
         if let Some(k) = self.stopped_at {
             not_checked.push(format!(

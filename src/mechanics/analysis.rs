@@ -18,7 +18,7 @@ use super::model::{Capacity, Model};
 use super::pose_hull;
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
-use super::structure::{End, Link, Structure};
+use super::structure::{End, Link, MAX_HULL_GROUPS, Structure};
 use super::sweep_bisection;
 use glam::DVec3;
 use nalgebra::Matrix3;
@@ -73,6 +73,40 @@ pub enum Critical {
     Pivot(usize),
 }
 
+/// Why a component's poses between its samples were not judged: its
+/// verdict holds at the sampled poses of the movers' sweeps, and between
+/// them it is not proved.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SampledOnly {
+    /// The elastic screen found no witness (a mechanism, or every support
+    /// released): the limit analysis judged the samples.
+    NoElasticWitness,
+    /// Its loads were solved pose by pose (`movers` movers: more than
+    /// superposing two unit moments each pays for), so no bound of an
+    /// interval's poses was formed.
+    PoseByPose { movers: usize },
+    /// The step's movers turn at more than [`MAX_HULL_GROUPS`] rates: the
+    /// poses between samples are not enumerated (`Structure::between`).
+    TurningRates { groups: usize },
+}
+
+impl SampledOnly {
+    /// Why, in words, for reports.
+    pub fn describe(self) -> String {
+        match self {
+            SampledOnly::NoElasticWitness => {
+                "the elastic screen found no witness; the limit analysis judged the samples".into()
+            }
+            SampledOnly::PoseByPose { movers } => {
+                format!("{movers} movers on one component: its loads were solved pose by pose")
+            }
+            SampledOnly::TurningRates { groups } => format!(
+                "the movers turn at {groups} rates (poses between samples are enumerated for at most {MAX_HULL_GROUPS})"
+            ),
+        }
+    }
+}
+
 /// Full result of a static analysis.
 #[derive(Clone, Debug, Default)]
 pub struct Analysis {
@@ -112,11 +146,9 @@ pub struct Analysis {
     /// Poses between samples judged one by one ([`Structure::between`]):
     /// those of the intervals a bound of the whole interval did not clear.
     pub between_poses: usize,
-    /// Components judged at the samples alone: their loads were solved
-    /// pose by pose (more movers than superposition pays for), or their
-    /// movers turn at more than `MAX_HULL_GROUPS` (3)
-    /// rates. Between their samples the verdict is not proved.
-    pub sampled_only: usize,
+    /// Components judged at the samples alone, each with why (see
+    /// [`SampledOnly`]). Between their samples the verdict is not proved.
+    pub sampled_only: Vec<SampledOnly>,
     pub critical: Option<Critical>,
     pub verdict: Option<Verdict>,
     /// CG iterations (preconditioned by a kept factor, or refining a fresh
@@ -153,8 +185,8 @@ struct Screen {
     /// interval did not clear them).
     between_judged: usize,
     /// Movers hang on the component but its poses between samples were
-    /// not judged (see [`Analysis::sampled_only`]).
-    sampled_only: bool,
+    /// not judged, and why (see [`Analysis::sampled_only`]).
+    sampled_only: Option<SampledOnly>,
 }
 
 /// A failing component as [`Analyzer::tighten`] sees it: component `c`
@@ -800,7 +832,7 @@ impl Analyzer {
                 out.links[li] = *r;
             }
             out.between_poses += screen.between_judged;
-            out.sampled_only += usize::from(screen.sampled_only);
+            out.sampled_only.extend(screen.sampled_only);
             if !screen.failing.is_empty() {
                 let mut limit = if self.settings.limit_analysis {
                     self.limit(s, &comps, c, &screen.failing)
@@ -861,7 +893,7 @@ impl Analyzer {
             // Whether the component stands is for the limit analysis to
             // say, at every pose.
             screen.links = vec![LinkResult::default(); links.len()];
-            screen.sampled_only = poses.len() > 1;
+            screen.sampled_only = (poses.len() > 1).then_some(SampledOnly::NoElasticWitness);
             screen.failing = poses.into_iter().map(|p| (p, f64::INFINITY)).collect();
         };
         if !st.anchored || !st.converged {
@@ -905,7 +937,16 @@ impl Analyzer {
         // mover's moment on its pivot, which lies across gravity: two unit
         // moments per mover span every pose, so with few movers the poses
         // are superposed from 2·movers solutions instead of one each.
-        let superpose = poses.len() > 1 && 2 * movers.len() + 1 < poses.len();
+        // Superposition also gives each interval between samples its
+        // bound (`interval_clear`), without which the poses between them
+        // go unjudged: where those are enumerated it pays up to one
+        // solve per interval more.
+        let intervals = if s.between.is_empty() {
+            0
+        } else {
+            n_samples.saturating_sub(1)
+        };
+        let superpose = poses.len() > 1 && 2 * movers.len() + 1 < poses.len() + intervals;
         let (e1, e2) = {
             let e1 = s.gravity.any_orthonormal_vector();
             (e1, s.gravity.cross(e1))
@@ -986,7 +1027,15 @@ impl Analyzer {
             }
         }
         let judged_between = superpose && !s.between.is_empty();
-        screen.sampled_only = n_samples > 1 && self.settings.envelope && !judged_between;
+        if n_samples > 1 && self.settings.envelope && !judged_between {
+            screen.sampled_only = Some(if superpose {
+                SampledOnly::TurningRates { groups: s.groups() }
+            } else {
+                SampledOnly::PoseByPose {
+                    movers: movers.len(),
+                }
+            });
+        }
         if judged_between {
             // Between samples: the poses of `Structure::between` whose
             // loads may reach the corner gate are judged for the verdict.

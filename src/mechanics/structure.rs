@@ -366,6 +366,11 @@ impl Structure {
         s
     }
 
+    /// The turning rates the movers' sweeps fall into (`Hanging::group`).
+    pub fn groups(&self) -> usize {
+        self.hanging.iter().map(|h| h.group + 1).max().unwrap_or(0)
+    }
+
     /// Mover `h`'s centre at pose `k`: sample `k` of its path, or a pose
     /// between samples ([`Structure::between`]).
     pub fn mover_point(&self, h: usize, k: usize) -> DVec3 {

@@ -73,6 +73,11 @@ pub struct Row {
     /// worst-only study's time went.
     #[serde(default)]
     pub steps_judged: usize,
+    /// Steps where a component was judged at the sampled poses of the
+    /// movers' sweeps alone (`Analysis::sampled_only`): between samples
+    /// the row's figures are not proved there.
+    #[serde(default)]
+    pub steps_judged_at_samples: usize,
 }
 
 impl Row {
@@ -334,6 +339,9 @@ pub struct StepFinding {
     /// limit-analysed: `max_utilisation` is an upper bound.
     #[serde(default)]
     bounded: bool,
+    /// A component was judged at the sampled poses alone.
+    #[serde(default)]
+    sampled_only: bool,
 }
 
 impl StepFinding {
@@ -386,6 +394,7 @@ impl StepFinding {
             min_pressure_elastic: el,
             limit_analyses: a.limit_analyses,
             bounded: a.bounded > 0,
+            sampled_only: !a.sampled_only.is_empty(),
         }
     }
 }
@@ -676,6 +685,7 @@ fn empty_row(b: usize, steps: usize, m: &Model) -> Row {
         ),
         limit_analyses: 0,
         steps_bounded: 0,
+        steps_judged_at_samples: 0,
         equilibria_unproved: 0,
         steps_judged: 0,
     }
@@ -692,6 +702,7 @@ impl Row {
         // A bounded step was left bounded because its bound is no more
         // than the worst proved (see `prove_worst`): it cannot raise it.
         self.steps_bounded += usize::from(f.bounded);
+        self.steps_judged_at_samples += usize::from(f.sampled_only);
         self.equilibria_unproved += usize::from(f.bounded && f.max_utilisation == f64::INFINITY);
         if !f.bounded && f.max_utilisation > self.max_utilisation {
             self.max_utilisation = f.max_utilisation;
@@ -828,6 +839,26 @@ impl Study {
                     ""
                 },
                 bounded.join(", ")
+            );
+        }
+        let sampled: Vec<String> = self
+            .rows
+            .iter()
+            .filter(|r| r.steps_judged_at_samples > 0)
+            .map(|r| {
+                format!(
+                    "b = {}: {} of {}",
+                    r.b,
+                    r.steps_judged_at_samples,
+                    r.steps + 1
+                )
+            })
+            .collect();
+        if !sampled.is_empty() {
+            let _ = writeln!(
+                s,
+                "NOT checked: mechanics between the sampled poses of the movers' sweeps, at steps judged at the samples only: {}",
+                sampled.join(", ")
             );
         }
         let _ = writeln!(
@@ -1340,6 +1371,40 @@ mod tests {
         let (_, rh, el, table) = b_max_at_150(&row);
         assert_eq!((rh, el), (0, 0));
         assert!(table.contains("≥1.00"), "{table}");
+    }
+
+    #[test]
+    fn a_step_judged_at_its_samples_alone_is_counted_and_the_table_says_not_checked() {
+        let m = Model::default_catom();
+        let finding = |step: usize, sampled_only: bool| StepFinding {
+            step,
+            lattice_violations: 0,
+            no_equilibrium: false,
+            partial: false,
+            max_utilisation: 0.25,
+            critical: String::new(),
+            min_pressure_rigid_hinge: 1e3,
+            min_pressure_elastic: 1e3,
+            limit_analyses: 0,
+            bounded: false,
+            sampled_only,
+        };
+        let mut row = empty_row(4, 10, &m);
+        for k in 1..=11 {
+            row.fold(finding(k, k == 3 || k == 7));
+        }
+        assert_eq!(row.steps_judged_at_samples, 2);
+        let st = assemble("t", &m, vec![row.clone()], vec![], 0.0, Judging::Every);
+        assert!(
+            st.table().contains(
+                "NOT checked: mechanics between the sampled poses of the movers' sweeps, at steps judged at the samples only: b = 4: 2 of 11"
+            ),
+            "{}",
+            st.table()
+        );
+        row.steps_judged_at_samples = 0;
+        let st = assemble("t", &m, vec![row], vec![], 0.0, Judging::Every);
+        assert!(!st.table().contains("NOT checked"), "{}", st.table());
     }
 
     #[test]

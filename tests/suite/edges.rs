@@ -544,7 +544,7 @@ fn the_poses_between_samples_bound_a_dense_walk_of_the_moves() {
     assert!(built.hanging.len() == 5 && groups == 2, "{groups} groups");
     assert_eq!(built.between.len(), 24 * (9 - 2));
     // Every interval was cleared by its bound (nothing near capacity).
-    assert_eq!((a.between_poses, a.sampled_only), (0, 0));
+    assert_eq!((a.between_poses, a.sampled_only.len()), (0, 0));
     // Each structure's movers walk the given points, at a common index.
     let walking = |points: &dyn Fn(usize) -> Vec<glam::DVec3>| {
         let mut t = built.clone();
