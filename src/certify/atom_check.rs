@@ -23,7 +23,8 @@ use super::report::{REPORT_FORMAT, Report, StepResult, Violation, ViolationKind}
 use super::{Options, model_path};
 use crate::error::InputError;
 use crate::geometry::atom::{
-    Bond, Faces, MovingBox, atom_boxes, contact_face, first_overlap, solve_step, within_union,
+    Bond, Faces, MovingBox, atom_boxes, contact_face, first_overlap, solve_step, sweep_hull,
+    within_union,
 };
 use crate::lattice::config::ModuleId;
 use crate::lattice::{AtomRest, Cell, Face};
@@ -368,15 +369,7 @@ impl AtomState {
         let mut grid: FxHashMap<(i32, i32, i32), Vec<usize>> = FxHashMap::default();
         let mut hull_of: Vec<([f64; 3], [f64; 3])> = Vec::with_capacity(self.pos.len());
         for a in 0..self.pos.len() {
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for (_, b) in boxes(a) {
-                let (l, h) = b.hull();
-                for i in 0..3 {
-                    lo[i] = lo[i].min(l[i]);
-                    hi[i] = hi[i].max(h[i]);
-                }
-            }
+            let (lo, hi) = sweep_hull(&boxes(a));
             hull_of.push((lo, hi));
             for x in bucket(lo[0])..=bucket(hi[0]) {
                 for y in bucket(lo[1])..=bucket(hi[1]) {

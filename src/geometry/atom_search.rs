@@ -9,7 +9,9 @@
 //! valid step ending in the same state. The packed sequence is what
 //! schedules carry and what the certifier checks independently.
 
-use super::atom::{Bond, Faces, atom_boxes, contact_face, first_overlap, solve_step};
+use super::atom::{
+    Bond, Faces, atom_boxes, contact_face, first_overlap, solve_step, sweep_hull, sweeps_apart,
+};
 use crate::lattice::config::ModuleId;
 use crate::lattice::{Cell, Face};
 use crate::schedule::Event;
@@ -279,30 +281,10 @@ impl Scene {
         let boxes: Vec<_> = (0..self.pos.len())
             .map(|a| atom_boxes(self.pos[a], end[a], &self.ext[a], &ext1[a]))
             .collect();
-        // Each atom's sweep within one box: a pair whose boxes overlap by
-        // at most `eps` along some axis has no box pair that does, at any
-        // `s`, so `first_overlap` would clear it (cells are integers, the
-        // boxes finite; a tolerance that is no number is never screened).
-        let hulls: Vec<([f64; 3], [f64; 3])> = boxes
-            .iter()
-            .map(|bx| {
-                bx.iter().fold(
-                    ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-                    |(lo, hi), (_, b)| {
-                        let (l, h) = b.hull();
-                        (
-                            std::array::from_fn(|i| lo[i].min(l[i])),
-                            std::array::from_fn(|i| hi[i].max(h[i])),
-                        )
-                    },
-                )
-            })
-            .collect();
-        let screened = eps.is_finite() && eps >= 0.0;
-        let apart = |a: usize, b: usize| {
-            let ((la, ha), (lb, hb)) = (hulls[a], hulls[b]);
-            screened && (0..3).any(|i| ha[i].min(hb[i]) - la[i].max(lb[i]) <= eps)
-        };
+        // Each atom's sweep within one box: pairs whose boxes are apart
+        // need no box-by-box test (cells are integers, the boxes finite).
+        let hulls: Vec<([f64; 3], [f64; 3])> = boxes.iter().map(|bx| sweep_hull(bx)).collect();
+        let apart = |a: usize, b: usize| sweeps_apart(&hulls[a], &hulls[b], eps);
         for &a in &active {
             for b in 0..self.pos.len() {
                 if b == a || (b < a && active.contains(&b)) || apart(a, b) {
@@ -1169,6 +1151,26 @@ mod tests {
         let mut shuffled = p.start.clone();
         shuffled.pos[a].y += 1;
         assert!(p.within_reach(&shuffled));
+    }
+
+    #[test]
+    fn an_arm_expanding_into_an_unattached_neighbour_is_refused_and_one_into_space_is_not() {
+        // A contracted 2 × 2 square, attached around but for 0–2: 0's +y
+        // arm would enter 2 (nothing pushes it), its −x arm meets nothing.
+        let c = |x, y| Cell::new(x, y, 0);
+        let s = Scene {
+            pos: vec![c(0, 0), c(1, 0), c(0, 1), c(1, 1)],
+            ext: vec![[false; 6]; 4],
+            bonds: [(0, 1), (1, 3), (2, 3)].into_iter().collect(),
+        };
+        assert!(s.step(&[Op::Expand(0, Face::PosY)], &[0], 1e-9).is_none());
+        assert!(s.step(&[Op::Expand(0, Face::NegX)], &[0], 1e-9).is_some());
+        for eps in [f64::NAN, f64::INFINITY, -1.0] {
+            assert!(
+                s.step(&[Op::Expand(0, Face::NegX)], &[0], eps).is_none(),
+                "{eps}"
+            );
+        }
     }
 
     #[test]

@@ -1574,7 +1574,7 @@ impl Analyzer {
         basis: &[(usize, DVec3, DVec3, Vec<Vec6>)],
         i: usize,
     ) -> bool {
-        let groups = s.hanging.iter().map(|h| h.group + 1).max().unwrap_or(0);
+        let groups = s.groups();
         let zero = vec![Vec6::zeros(); active.len()];
         let mut at_i = sf_reference.to_vec();
         let mut share = vec![[zero.clone(), zero]; groups];

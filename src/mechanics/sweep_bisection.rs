@@ -91,7 +91,7 @@ pub struct Sweep {
 /// [`Structure::between`]).
 pub fn sweep(s: &Structure) -> Option<Sweep> {
     let n = s.hanging.first()?.path.len();
-    let groups = s.hanging.iter().map(|h| h.group + 1).max()?;
+    let groups = s.groups();
     let same = s
         .hanging
         .iter()
@@ -214,7 +214,7 @@ pub fn hull(s: &Structure, i: usize, j: usize) -> Option<RunHull> {
         }
         t.push(0.5 * (q1 + q2));
     }
-    let groups = s.hanging.iter().map(|h| h.group + 1).max().unwrap_or(0);
+    let groups = s.groups();
     let inside = |g: usize, point: &dyn Fn(usize) -> DVec3| -> Option<[f64; 3]> {
         // point_h = A_h + β(T_h − A_h) + γ(B_h − A_h), one (β, γ) for
         // the group's movers, by least squares; then each one's residual.
