@@ -18,7 +18,8 @@ use super::model::{Capacity, Model};
 use super::pose_hull;
 use super::reuse::KeptFactor;
 use super::solver::{Block, BlockMatrix, Vec6, jacobi_pcg, pcg, transfer};
-use super::structure::{End, Link, MAX_HULL_GROUPS, Structure};
+use super::structure::{End, Hanging, Link, MAX_HULL_GROUPS, Structure};
+use super::superposition::{self, Unit};
 use super::sweep_bisection;
 use glam::DVec3;
 use nalgebra::Matrix3;
@@ -81,8 +82,9 @@ pub enum SampledOnly {
     /// The elastic screen found no witness (a mechanism, or every support
     /// released): the limit analysis judged the samples.
     NoElasticWitness,
-    /// Its loads were solved pose by pose (`movers` movers: more than
-    /// superposing two unit moments each pays for), so no bound of an
+    /// Its loads were solved pose by pose (`movers` movers, turning at so
+    /// many rates that superposing their moments took as many solves as
+    /// the poses and intervals: `superposition`), so no bound of an
     /// interval's poses was formed.
     PoseByPose { movers: usize },
     /// The step's movers turn at more than [`MAX_HULL_GROUPS`] rates: the
@@ -271,6 +273,12 @@ pub struct Settings {
     /// ([`sweep_bisection`]) where it applies; off, it solves every pose
     /// (the comparison the tests make).
     pub bisect_sweeps: bool,
+    /// Superpose the poses of the movers' sweeps from a few unit load
+    /// cases per group of movers ([`superposition`]), which also judges
+    /// the poses between samples; off, every sampled pose is solved alone
+    /// and the poses between samples are not judged (the comparison the
+    /// tests make).
+    pub superpose: bool,
     /// CG iterations allowed with a kept factor before it is refreshed.
     pub reuse_iterations: usize,
     /// The kept factor is tried only while at most this many bodies were
@@ -320,6 +328,7 @@ impl Default for Settings {
             tolerance: 1e-10,
             max_release_rounds: 30,
             bisect_sweeps: true,
+            superpose: true,
             reuse_iterations: REUSE_ITERATIONS,
             reuse_max_changed: REUSE_MAX_CHANGED,
             envelope: true,
@@ -933,36 +942,44 @@ impl Analyzer {
                 .collect()
         };
         let sf_reference = sf_of(&st.q);
-        // The loads of a pose differ from the reference only by each
-        // mover's moment on its pivot, which lies across gravity: two unit
-        // moments per mover span every pose, so with few movers the poses
-        // are superposed from 2·movers solutions instead of one each.
-        // Superposition also gives each interval between samples its
-        // bound (`interval_clear`), without which the poses between them
-        // go unjudged: where those are enumerated it pays up to one
-        // solve per interval more.
+        // The loads of a pose differ from the reference only by the
+        // movers' moments on their pivots, and one group's moments span at
+        // most three dimensions however many movers it has
+        // (`superposition`): the poses are superposed from a few unit
+        // solutions instead of one solve each. Superposition also gives
+        // each interval between samples its bound (`interval_uncleared`),
+        // without which the poses between them go unjudged: where those
+        // are enumerated it pays up to one solve per interval more.
         let intervals = if s.between.is_empty() {
             0
         } else {
             n_samples.saturating_sub(1)
         };
-        let superpose = poses.len() > 1 && 2 * movers.len() + 1 < poses.len() + intervals;
+        let mut references = vec![DVec3::ZERO; s.hanging.len()];
+        for &h in &movers {
+            references[h] = mover_moment(s, h, None);
+        }
+        let units: Option<Vec<Unit>> = (poses.len() > 1 && self.settings.superpose)
+            .then(|| {
+                superposition::units(s, &movers, &|h, c| moment_at(s, h, c), &|h| references[h])
+            })
+            .flatten()
+            .filter(|u| u.len() < poses.len() + intervals);
+        let superpose = units.is_some();
+        let units = units.unwrap_or_default();
         let (e1, e2) = {
             let e1 = s.gravity.any_orthonormal_vector();
             (e1, s.gravity.cross(e1))
         };
-        let units: Vec<(usize, DVec3)> = if superpose {
-            movers.iter().flat_map(|&h| [(h, e1), (h, e2)]).collect()
-        } else {
-            Vec::new()
-        };
         let rhs: Vec<Vec<Vec6>> = if superpose {
             units
                 .iter()
-                .map(|&(h, e)| {
+                .map(|u| {
                     let mut f_unit = vec![Vec6::zeros(); bodies.len()];
-                    f_unit[local[s.hanging[h].pivot] as usize] =
-                        Vec6::new(0.0, 0.0, 0.0, e.x, e.y, e.z);
+                    for &(h, m) in &u.moments {
+                        f_unit[local[s.hanging[h].pivot] as usize] +=
+                            Vec6::new(0.0, 0.0, 0.0, m.x, m.y, m.z);
+                    }
                     f_unit
                 })
                 .collect()
@@ -979,13 +996,11 @@ impl Analyzer {
             no_witness(&mut screen, poses);
             return (screen, reference);
         };
-        // Per unit solution: its mover, axis, the mover's reference moment
-        // (taken once, not per pose) and the interface forces.
-        let basis: Vec<(usize, DVec3, DVec3, Vec<Vec6>)> = if superpose {
+        // Per unit solution: the unit and the interface forces.
+        let basis: Vec<(Unit, Vec<Vec6>)> = if superpose {
             units
                 .into_iter()
                 .zip(solutions.iter().map(|q_k| sf_of(q_k)))
-                .map(|((h, e), sf)| (h, e, mover_moment(s, h, None), sf))
                 .collect()
         } else {
             Vec::new()
@@ -997,8 +1012,8 @@ impl Analyzer {
         // A pose's interface forces superposed from the unit solutions.
         let superposed = |pose: Option<usize>, sf: &mut Vec<Vec6>| {
             sf.clone_from(&sf_reference);
-            for (h, e, reference, sf_b) in &basis {
-                let c = (mover_moment(s, *h, pose) - *reference).dot(*e);
+            for (u, sf_b) in &basis {
+                let c = u.coordinate(|h| mover_moment(s, h, pose) - references[h]);
                 if c != 0.0 {
                     sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                 }
@@ -1037,23 +1052,38 @@ impl Analyzer {
             });
         }
         if judged_between {
-            // Between samples: the poses of `Structure::between` whose
-            // loads may reach the corner gate are judged for the verdict.
+            // Between samples: the poses of `Structure::between` are judged
+            // for the verdict at the links whose loads there may reach the
+            // corner gate (the others stay below it at every such pose).
             let per_interval = s.between.len() / (n_samples - 1);
             for i in 0..n_samples - 1 {
-                if !self.interval_clear(s, &active, &sf_reference, &basis, i) {
-                    for v in i * per_interval..(i + 1) * per_interval {
-                        let pose = Some(n_samples + v);
-                        superposed(pose, &mut sf);
-                        let sf_link = |li: usize| &sf[slot[li]];
-                        let mut scratch = vec![LinkResult::default(); links.len()];
-                        let judged = self.judge_pose(s, links, &st, &sf_link, true, &mut scratch);
-                        screen.between_judged += 1;
-                        if overloaded(judged.worst) || overloaded(judged.gate) {
-                            screen
-                                .failing
-                                .push((pose, judged.worst.max(severity(judged.scale))));
+                let open =
+                    self.interval_uncleared(s, &active, &sf_reference, &basis, &references, i);
+                if open.is_empty() {
+                    continue;
+                }
+                for v in i * per_interval..(i + 1) * per_interval {
+                    let pose = Some(n_samples + v);
+                    let cs: Vec<f64> = basis
+                        .iter()
+                        .map(|(u, _)| u.coordinate(|h| mover_moment(s, h, pose) - references[h]))
+                        .collect();
+                    let mut judged = Judged::default();
+                    for &j in &open {
+                        let mut f = sf_reference[j];
+                        for ((_, sf_b), c) in basis.iter().zip(&cs) {
+                            f += *c * sf_b[j];
                         }
+                        let one = self.judge_link(s, active[j], &f);
+                        judged.worst = judged.worst.max(one.worst);
+                        judged.gate = judged.gate.max(one.gate);
+                        judged.scale = judged.scale.max(one.scale);
+                    }
+                    screen.between_judged += 1;
+                    if overloaded(judged.worst) || overloaded(judged.gate) {
+                        screen
+                            .failing
+                            .push((pose, judged.worst.max(severity(judged.scale))));
                     }
                 }
             }
@@ -1556,62 +1586,69 @@ impl Analyzer {
         j_out
     }
 
-    /// Whether every pose between samples `i` and `i + 1` is cleared by one
-    /// bound: a pose there moves each group of movers to sample `i + 1` or
-    /// to the tangent point, which adds to each link's load at sample `i`
-    /// the group's share of the change; with every component of those
-    /// shares at its largest magnitude (the utilisation grows with each
-    /// of the tension, shear, torsion and bending magnitudes), the link
-    /// stays below the utilisation at which the corner construction always
-    /// carries it (`CORNER_FREE_BELOW`): an elastic witness at every such
-    /// pose. `basis`: per unit solution its mover, axis, reference moment
-    /// and interface forces (of the `active` links).
-    fn interval_clear(
+    /// The links (positions in `active`) that one bound does not clear at
+    /// every pose between samples `i` and `i + 1`: a pose there moves each
+    /// group of movers to sample `i + 1` or to the tangent point, which
+    /// adds to each link's load at sample `i` the group's share of the
+    /// change; with every component of those shares at its largest
+    /// magnitude (the utilisation grows with each of the tension, shear,
+    /// torsion and bending magnitudes), a cleared link stays below the
+    /// utilisation at which the corner construction always carries it
+    /// (`CORNER_FREE_BELOW`): an elastic witness at every such pose, so
+    /// only the others are judged there. `basis`: per unit solution its
+    /// unit and interface forces (of the `active` links); `references`:
+    /// each mover's reference moment.
+    fn interval_uncleared(
         &self,
         s: &Structure,
         active: &[usize],
         sf_reference: &[Vec6],
-        basis: &[(usize, DVec3, DVec3, Vec<Vec6>)],
+        basis: &[(Unit, Vec<Vec6>)],
+        references: &[DVec3],
         i: usize,
-    ) -> bool {
+    ) -> Vec<usize> {
         let groups = s.groups();
         let zero = vec![Vec6::zeros(); active.len()];
         let mut at_i = sf_reference.to_vec();
         let mut share = vec![[zero.clone(), zero]; groups];
-        for (h, e, reference, sf_b) in basis {
-            let hg = &s.hanging[*h];
-            let m = |c: DVec3| moment_at(s, *h, c);
-            let m_i = m(hg.path[i]);
-            let c = (m_i - *reference).dot(*e);
-            let c1 = (m(hg.path[i + 1]) - m_i).dot(*e);
-            let ct = (m(hg.hull[i]) - m_i).dot(*e);
-            let [to_next, to_tangent] = &mut share[hg.group];
+        for (u, sf_b) in basis {
+            let at = |point: &dyn Fn(&Hanging) -> DVec3| {
+                u.coordinate(|h| moment_at(s, h, point(&s.hanging[h])) - references[h])
+            };
+            let c = at(&|hg| hg.path[i]);
+            let c1 = at(&|hg| hg.path[i + 1]) - c;
+            let ct = at(&|hg| hg.hull[i]) - c;
+            let [to_next, to_tangent] = &mut share[u.group];
             for (j, y) in sf_b.iter().enumerate() {
                 at_i[j] += c * y;
                 to_next[j] += c1 * y;
                 to_tangent[j] += ct * y;
             }
         }
-        active.iter().enumerate().all(|(j, &li)| {
-            let l = &s.links[li];
-            let base = self.load_of(l, &at_i[j]).0;
-            let mut worst = ConnectorLoad {
-                axial: base.axial,
-                shear: base.shear,
-                torsion: base.torsion.abs(),
-                moment_u: base.moment_u.abs(),
-                moment_v: base.moment_v.abs(),
-            };
-            for [a, b] in &share {
-                let (a, b) = (self.load_of(l, &a[j]).0, self.load_of(l, &b[j]).0);
-                worst.axial += a.axial.abs().max(b.axial.abs());
-                worst.shear += a.shear.max(b.shear);
-                worst.torsion += a.torsion.abs().max(b.torsion.abs());
-                worst.moment_u += a.moment_u.abs().max(b.moment_u.abs());
-                worst.moment_v += a.moment_v.abs().max(b.moment_v.abs());
-            }
-            utilisation(&worst, self.capacity(l)).0 <= CORNER_FREE_BELOW
-        })
+        (0..active.len())
+            .filter(|&j| {
+                let li = active[j];
+                let l = &s.links[li];
+                let base = self.load_of(l, &at_i[j]).0;
+                let mut worst = ConnectorLoad {
+                    axial: base.axial,
+                    shear: base.shear,
+                    torsion: base.torsion.abs(),
+                    moment_u: base.moment_u.abs(),
+                    moment_v: base.moment_v.abs(),
+                };
+                for [a, b] in &share {
+                    let (a, b) = (self.load_of(l, &a[j]).0, self.load_of(l, &b[j]).0);
+                    worst.axial += a.axial.abs().max(b.axial.abs());
+                    worst.shear += a.shear.max(b.shear);
+                    worst.torsion += a.torsion.abs().max(b.torsion.abs());
+                    worst.moment_u += a.moment_u.abs().max(b.moment_u.abs());
+                    worst.moment_v += a.moment_v.abs().max(b.moment_v.abs());
+                }
+                // (NaN ranks above every finite utilisation: not cleared.)
+                severity(utilisation(&worst, self.capacity(l)).0) > CORNER_FREE_BELOW
+            })
+            .collect()
     }
 
     /// One link's result from its interface force `sf` (units `W`, `W·d`).

@@ -18,6 +18,8 @@
 //!   poses, where a region's bound is proved once for all of them;
 //!   `sweep_bisection` — a sweep's smallest factor by branch and bound
 //!   along the movers' path, bounding runs of poses by one triangle each.
+//! * `superposition` — a step's poses as a few unit load cases: at most
+//!   three per group of movers turning at one rate, however many movers.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
@@ -32,6 +34,7 @@ pub(crate) mod pose_hull;
 pub(crate) mod reuse;
 pub(crate) mod solver;
 pub(crate) mod structure;
+pub(crate) mod superposition;
 pub(crate) mod sweep_bisection;
 
 pub use analysis::{Analysis, Analyzer, Critical, LinkResult, Verdict};

@@ -1367,3 +1367,174 @@ fn a_region_limit_analysis_tightens_the_screens_bound_and_never_passes_the_prove
         );
     }
 }
+
+/// A wall two layers high (x = 0 … `n`), fixed at x = 0, or (`resting`)
+/// on the ground beside a second row with nothing fixed, and a crowd on
+/// its top: two movers on every module of the top layer, rolling over it
+/// from one cell above to another, one across a 90° link and (`two`) one
+/// across a 60° link by the hexagonal route — one or two groups turning at
+/// one rate, however many movers. `mirror` reflects it in y = 0.
+fn crowded_wall(n: i32, resting: bool, mirror: bool, two: bool) -> Structure {
+    let l = FccLattice;
+    let flip = |c: Cell| if mirror { Cell::new(c.x, -c.y, c.z) } else { c };
+    let mut cells: Vec<Cell> = (0..2)
+        .flat_map(|z| (0..=n).map(move |x| flip(Cell::new(x, 0, z))))
+        .collect();
+    if resting {
+        cells.extend((0..=n).map(|x| flip(Cell::new(x, -1, 0))));
+    }
+    // Two cells above a pivot whose directions from it meet at `cos`.
+    let above = |pivot: Cell, cos: f64| -> (Cell, Cell) {
+        let up: Vec<Cell> = (0..12)
+            .map(|i| l.neighbour(pivot, i))
+            .filter(|c| c.z == pivot.z + 1)
+            .collect();
+        let dir = |c: Cell| (l.centre(c) - l.centre(pivot)).normalize();
+        up.iter()
+            .flat_map(|&a| up.iter().map(move |&b| (a, b)))
+            .find(|&(a, b)| (dir(a).dot(dir(b)) - cos).abs() < 1e-9)
+            .expect("a pair of cells above the pivot")
+    };
+    let mut movers: Vec<MoverSpec> = Vec::new();
+    let first_id = cells.len() as ModuleId + 1;
+    for x in 0..=n {
+        let pivot = flip(Cell::new(x, 0, 1));
+        let pivot_id = (n + 1 + x) as ModuleId + 1;
+        let links = if two {
+            vec![(0.0, Route::Octagonal), (0.5, Route::Hexagonal)]
+        } else {
+            vec![(0.0, Route::Octagonal); 2]
+        };
+        for (cos, route) in links {
+            let (from, to) = above(pivot, cos);
+            movers.push((
+                first_id + movers.len() as ModuleId,
+                Some(pivot_id),
+                Motion::Rotate {
+                    from,
+                    to,
+                    pivot,
+                    route,
+                },
+            ));
+        }
+    }
+    if resting {
+        structure(&l, Some(Ground { layer: 0 }), &cells, &[], &movers)
+    } else {
+        structure(&l, None, &cells, &[0], &movers)
+    }
+}
+
+/// The analysis of `s`, its poses superposed from the groups' unit load
+/// cases or (`superpose` off) each solved alone.
+fn superposed(model: &Model, s: &Structure, superpose: bool) -> super::analysis::Analysis {
+    let mut a = tight(model.clone());
+    a.settings.superpose = superpose;
+    a.analyse(s)
+}
+
+/// Superposing a crowd of movers from a few unit load cases per group
+/// (`superposition`) gives every sampled pose the field of its own solve:
+/// the same worst utilisation of every link, the same verdict and factor,
+/// on a fixed root, its mirror image and a wall resting on the ground (its
+/// contacts released at the reference pose either way); and it judges the
+/// poses between samples that solving pose by pose leaves unjudged.
+#[test]
+fn a_crowd_superposed_by_groups_gives_every_sampled_pose_its_own_solve() {
+    use super::analysis::SampledOnly;
+    let model = Model::default_catom();
+    for (n, resting, mirror, two) in [
+        (5, false, false, true),
+        (5, false, true, true),
+        (4, true, false, true),
+        (6, false, false, false),
+    ] {
+        let s = crowded_wall(n, resting, mirror, two);
+        let movers = s.hanging.len();
+        assert_eq!(
+            (movers, s.groups()),
+            (2 * (n as usize + 1), 1 + two as usize)
+        );
+        let (by_groups, alone) = (superposed(&model, &s, true), superposed(&model, &s, false));
+        let case = format!("n {n} resting {resting} mirror {mirror} two {two}");
+        assert_eq!(by_groups.verdict(), alone.verdict(), "{case}");
+        let (u, v) = (by_groups.max_utilisation, alone.max_utilisation);
+        assert!(u.is_finite() && u > 0.01, "{case}: {u}");
+        match (by_groups.load_factor, alone.load_factor) {
+            (None, None) => assert!((u - v).abs() <= 1e-9 * v, "{case}: {u} against {v}"),
+            // Poses between samples may lower the smallest factor: never
+            // raise it (the enumeration is the next test's).
+            (Some(a), Some(b)) => assert!(a <= b * (1.0 + 1e-7), "{case}: {a} against {b}"),
+            other => panic!("{case}: {other:?}"),
+        }
+        for (a, b) in by_groups.links.iter().zip(&alone.links) {
+            // (A ground contact the elastic field pulls: ∞ in both.)
+            assert!(
+                a.utilisation == b.utilisation || (a.utilisation - b.utilisation).abs() <= 1e-9 * v,
+                "{case}: a link at {} against {}",
+                a.utilisation,
+                b.utilisation
+            );
+        }
+        assert!(by_groups.sampled_only.is_empty(), "{case}");
+        assert_eq!(
+            alone.sampled_only,
+            vec![SampledOnly::PoseByPose { movers }],
+            "{case}"
+        );
+    }
+}
+
+/// Where the smallest load factor of a crowd's sweep lies between two
+/// samples, superposition finds it and solving pose by pose does not: with
+/// the connectors' pressure set between the two, the samples alone hold
+/// and a pose between them does not. The crowd turns at two rates on a
+/// wall resting on the ground; every one of its 193 poses (25 samples and
+/// the 168 corners between them) is analysed alone here, the crowd held
+/// at it.
+#[test]
+fn a_crowd_failing_only_between_its_samples_is_refused() {
+    let base = Model::default_catom();
+    let s = crowded_wall(4, true, false, true);
+    assert_eq!(s.groups(), 2);
+    let n = s.hanging[0].path.len();
+    let m = n + s.between.len();
+    // Pose k of the crowd alone: every mover at it, no path beyond it.
+    let at = |model: &Model, k: usize| -> f64 {
+        let mut one = s.clone();
+        for h in 0..one.hanging.len() {
+            let c = s.mover_point(h, k);
+            one.hanging[h].path = vec![c];
+            one.hanging[h].hull.clear();
+        }
+        one.between.clear();
+        Analyzer::new(model.clone(), false)
+            .analyse(&one)
+            .load_factor
+            .unwrap_or(f64::INFINITY)
+    };
+    let smallest = |model: &Model, poses: std::ops::Range<usize>| {
+        poses.map(|k| at(model, k)).fold(f64::INFINITY, f64::min)
+    };
+    let (samples, between) = (smallest(&base, 0..n), smallest(&base, n..m));
+    assert!(between < samples, "{between} against {samples}");
+    // The pressure at which the samples' smallest factor is
+    // sqrt(samples / between) > 1 and the tangent poses' its inverse.
+    let mut model = base.clone();
+    model.connector.pressure *= 1.0 / (samples * between).sqrt();
+    let (samples, between) = (smallest(&model, 0..n), smallest(&model, n..m));
+    assert!(samples > 1.0 && between < 1.0, "{samples} {between}");
+    let alone = Analyzer::new(model.clone(), false);
+    let mut alone = alone;
+    alone.settings.superpose = false;
+    let a = alone.analyse(&s);
+    assert_eq!(a.verdict(), Verdict::Stable, "the samples alone hold");
+    let b = Analyzer::new(model.clone(), false).analyse(&s);
+    assert_eq!(b.verdict(), Verdict::Overloaded);
+    let lambda = b.load_factor.unwrap();
+    assert!(
+        (lambda - between).abs() <= 1e-5 * between,
+        "{lambda} against {between}"
+    );
+}
