@@ -1714,14 +1714,51 @@ impl Analyzer {
             bodies: &comps.bodies[c],
             links: &comps.links[c],
         };
-        if let Some((bisected, setting)) = self.bisect(s, part, failing) {
-            out.capacities = bisected.smallest;
-            out.lower = bisected.lower;
-            out.partial = bisected.partial;
-            out.runs = bisected.solves;
-            out.setting = setting;
-            self.rigid(s, part, failing, &mut out);
-            return out;
+        let dominated = dominated_samples(s, failing);
+        let tolerance = self.settings.load_factor_tolerance;
+        let solve_pose = |pose: Option<usize>, start: usize| {
+            let loads = body_loads(s, pose);
+            let (model, c) = (&self.model, Connectors::Capacities);
+            // Equilibria are kept only to bound later poses.
+            if tolerance > 0.0 {
+                limit::load_factor_with_field(s, model, &loads, part, c, start)
+            } else {
+                (
+                    limit::load_factor_from(s, model, &loads, part, c, start),
+                    None,
+                )
+            }
+        };
+        // Where the bisection applies, the worst pose first, alone: a
+        // failing step usually fails there, and the enumeration below then
+        // stops after that one solve, where the bisection's first corners
+        // (the sweep's ends and apex, `3^G` of them) take several. A pose
+        // that holds is handed to the bisection, which does not solve it
+        // again.
+        let mut probed = None;
+        let mut start = self.limit_setting;
+        if self.bisection_applies(s, failing)
+            && let Some(i0) = (0..failing.len()).find(|&i| !dominated[i])
+        {
+            let r = solve_pose(failing[i0].0, start);
+            if r.0.setting < limit::SETTINGS.len() {
+                start = r.0.setting;
+            }
+            if !fails(r.0.lambda) {
+                let known = failing[i0].0.map(|k| (k, r.0.lambda));
+                if let Some((bisected, setting, reused)) =
+                    self.bisect(s, part, failing, known, start)
+                {
+                    out.capacities = bisected.smallest;
+                    out.lower = bisected.lower;
+                    out.partial = bisected.partial;
+                    out.runs = bisected.solves + 1 - reused;
+                    out.setting = setting;
+                    self.rigid(s, part, failing, &mut out);
+                    return out;
+                }
+            }
+            probed = Some((i0, r));
         }
         // The poses' problems are independent: past the first (a failing
         // step usually fails there), they are solved in waves of as many
@@ -1730,14 +1767,17 @@ impl Analyzer {
         // solved one spares: results do not depend on threads.
         let mut solved: Vec<Option<(limit::LimitResult, Option<limit::Field>)>> =
             failing.iter().map(|_| None).collect();
-        let tolerance = self.settings.load_factor_tolerance;
         let mut fields: Vec<(Option<usize>, limit::Field)> = Vec::new();
         let mut wave = 1;
         // The setting the first solve needed starts the others
         // (`limit::load_factor_from`): the first wave is that one pose.
-        let (mut start, mut first_wave) = (self.limit_setting, true);
+        let mut first_wave = true;
+        if let Some((i0, r)) = probed {
+            solved[i0] = Some(r);
+            first_wave = false;
+            wave = rayon::current_num_threads().max(1);
+        }
         let mut failed = false;
-        let dominated = dominated_samples(s, failing);
         for (i, &(pose, bound)) in failing.iter().enumerate() {
             if out.capacities.is_nan() || 1.0 / out.capacities >= bound {
                 break;
@@ -1790,19 +1830,7 @@ impl Analyzer {
                 }
                 let results: Vec<_> = ahead
                     .par_iter()
-                    .map(|&j| {
-                        let loads = body_loads(s, failing[j].0);
-                        let (model, c) = (&self.model, Connectors::Capacities);
-                        // Equilibria are kept only to bound later poses.
-                        if tolerance > 0.0 {
-                            limit::load_factor_with_field(s, model, &loads, part, c, start)
-                        } else {
-                            (
-                                limit::load_factor_from(s, model, &loads, part, c, start),
-                                None,
-                            )
-                        }
-                    })
+                    .map(|&j| solve_pose(failing[j].0, start))
                     .collect();
                 if first_wave {
                     let setting = results[0].0.setting;
@@ -1869,13 +1897,34 @@ impl Analyzer {
     /// The first solve runs alone, to learn the solver setting the others
     /// start from ([`limit::load_factor_from`]); the rest of each batch
     /// the bisection asks for run in parallel.
+    /// Whether [`Analyzer::bisect`] takes these failing poses.
+    fn bisection_applies(&self, s: &Structure, failing: &[(Option<usize>, f64)]) -> bool {
+        if !self.settings.bisect_sweeps {
+            return false;
+        }
+        let Some(sweep) = sweep_bisection::sweep(s) else {
+            return false;
+        };
+        let all = sweep.n + s.between.len();
+        let wanted = failing
+            .iter()
+            .filter(|(p, _)| p.is_some_and(|k| k < all))
+            .count();
+        2 * wanted >= all
+    }
+
+    /// `known`: a pose already solved, and its factor, not solved again.
+    /// Returns the bisection's outcome, the solver setting and how many
+    /// of its solves `known` answered (0 or 1).
     fn bisect(
         &self,
         s: &Structure,
         part: limit::Part<'_>,
         failing: &[(Option<usize>, f64)],
-    ) -> Option<(sweep_bisection::Outcome, usize)> {
-        if !self.settings.bisect_sweeps {
+        known: Option<(usize, f64)>,
+        start: usize,
+    ) -> Option<(sweep_bisection::Outcome, usize, usize)> {
+        if !self.bisection_applies(s, failing) {
             return None;
         }
         let sweep = sweep_bisection::sweep(s)?;
@@ -1889,18 +1938,25 @@ impl Analyzer {
                 elastic[k] = Some(if known { 1.0 / bound } else { 0.0 });
             }
         }
-        // Where few poses fail, solving them (the enumeration, with its
-        // elastic bounds) costs less than the bisection's corners.
-        let wanted = elastic.iter().filter(|e| e.is_some()).count();
-        if 2 * wanted < elastic.len() {
-            return None;
-        }
-        let mut start = self.limit_setting;
-        let mut first = true;
+        let mut start = start;
+        let mut first = known.is_none();
         let model = &self.model;
+        let reused = std::sync::atomic::AtomicUsize::new(0);
         let factor = |corner: &sweep_bisection::Corner, start: usize| {
             let loads = match corner {
-                sweep_bisection::Corner::Pose(k) => body_loads(s, Some(*k)),
+                sweep_bisection::Corner::Pose(k) => {
+                    if let Some((_, lambda)) = known.filter(|(p, _)| p == k) {
+                        reused.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        return limit::LimitResult {
+                            lambda,
+                            iterations: 0,
+                            tries: 0,
+                            setting: start,
+                            solver_lambda: lambda,
+                        };
+                    }
+                    body_loads(s, Some(*k))
+                }
                 sweep_bisection::Corner::Centres(centres) => body_loads_at(s, centres),
             };
             limit::load_factor_from(s, model, &loads, part, Connectors::Capacities, start)
@@ -1928,7 +1984,7 @@ impl Analyzer {
         let floor = |k: usize| elastic[k];
         let tolerance = self.settings.load_factor_tolerance;
         let outcome = sweep_bisection::smallest_factor(s, &sweep, &mut solve, &floor, tolerance);
-        Some((outcome, start))
+        Some((outcome, start, reused.into_inner()))
     }
 
     /// The bound by which the fields solved so far prove that `pose`

@@ -1538,3 +1538,54 @@ fn a_crowd_failing_only_between_its_samples_is_refused() {
         "{lambda} against {between}"
     );
 }
+
+/// A failing step usually fails at its worst pose: where the bisection
+/// would take a sweep (every pose of two groups failing the screen), that
+/// pose is solved first, alone, and the step is refused after that one
+/// limit analysis, as the enumeration refuses it, with the same factor
+/// and lower end; a holding sweep is bisected as before, the probe's pose
+/// not solved twice.
+#[test]
+fn a_failing_sweep_is_refused_after_its_worst_pose_alone() {
+    let base = Model::default_catom();
+    let s = two_group_swing(7, false);
+    let holding = bisected(&base, &s, true);
+    assert_eq!(holding.verdict(), Verdict::Stable);
+    assert!(holding.load_factor.is_some());
+    // The weakest connectors that still leave a failing step's factor
+    // well above 0.
+    let mut weak = base.clone();
+    let (a, full) = loop {
+        weak.connector.pressure *= 0.8;
+        let full = bisected(&weak, &s, false);
+        if full.verdict() == Verdict::Overloaded {
+            break (bisected(&weak, &s, true), full);
+        }
+        assert!(weak.connector.pressure > 1e-3 * base.connector.pressure);
+    };
+    assert_eq!(a.verdict(), Verdict::Overloaded);
+    assert_eq!(a.limit_analyses, 1);
+    assert_eq!(full.limit_analyses, 1);
+    assert_eq!(a.load_factor, full.load_factor);
+    assert_eq!(a.load_factor_lower, full.load_factor_lower);
+    assert!(a.load_factor_partial);
+    // Every pose alone: none lower than the reported lower end.
+    let every = (0..s.hanging[0].path.len() + s.between.len())
+        .map(|k| {
+            let mut one = s.clone();
+            for h in 0..one.hanging.len() {
+                let c = s.mover_point(h, k);
+                one.hanging[h].path = vec![c];
+                one.hanging[h].hull.clear();
+            }
+            one.between.clear();
+            Analyzer::new(weak.clone(), false)
+                .analyse(&one)
+                .load_factor
+                .unwrap()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let lower = a.load_factor_lower.unwrap();
+    assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
+    assert!(a.load_factor.unwrap() >= every * (1.0 - 1e-5));
+}
