@@ -1486,6 +1486,21 @@ fn a_crowd_superposed_by_groups_gives_every_sampled_pose_its_own_solve() {
     }
 }
 
+/// The load factor of `s` with every mover held at pose `k` (a sample or
+/// a pose between samples, `Structure::mover_point`), no path beyond it;
+/// `None` where the elastic screen clears it.
+fn factor_at_pose(model: &Model, s: &Structure, k: usize) -> Option<f64> {
+    let mut one = s.clone();
+    for h in 0..one.hanging.len() {
+        one.hanging[h].path = vec![s.mover_point(h, k)];
+        one.hanging[h].hull.clear();
+    }
+    one.between.clear();
+    Analyzer::new(model.clone(), false)
+        .analyse(&one)
+        .load_factor
+}
+
 /// Where the smallest load factor of a crowd's sweep lies between two
 /// samples, superposition finds it and solving pose by pose does not: with
 /// the connectors' pressure set between the two, the samples alone hold
@@ -1500,22 +1515,10 @@ fn a_crowd_failing_only_between_its_samples_is_refused() {
     assert_eq!(s.groups(), 2);
     let n = s.hanging[0].path.len();
     let m = n + s.between.len();
-    // Pose k of the crowd alone: every mover at it, no path beyond it.
-    let at = |model: &Model, k: usize| -> f64 {
-        let mut one = s.clone();
-        for h in 0..one.hanging.len() {
-            let c = s.mover_point(h, k);
-            one.hanging[h].path = vec![c];
-            one.hanging[h].hull.clear();
-        }
-        one.between.clear();
-        Analyzer::new(model.clone(), false)
-            .analyse(&one)
-            .load_factor
-            .unwrap_or(f64::INFINITY)
-    };
     let smallest = |model: &Model, poses: std::ops::Range<usize>| {
-        poses.map(|k| at(model, k)).fold(f64::INFINITY, f64::min)
+        poses
+            .map(|k| factor_at_pose(model, &s, k).unwrap_or(f64::INFINITY))
+            .fold(f64::INFINITY, f64::min)
     };
     let (samples, between) = (smallest(&base, 0..n), smallest(&base, n..m));
     assert!(between < samples, "{between} against {samples}");
@@ -1571,19 +1574,7 @@ fn a_failing_sweep_is_refused_after_its_worst_pose_alone() {
     assert!(a.load_factor_partial);
     // Every pose alone: none lower than the reported lower end.
     let every = (0..s.hanging[0].path.len() + s.between.len())
-        .map(|k| {
-            let mut one = s.clone();
-            for h in 0..one.hanging.len() {
-                let c = s.mover_point(h, k);
-                one.hanging[h].path = vec![c];
-                one.hanging[h].hull.clear();
-            }
-            one.between.clear();
-            Analyzer::new(weak.clone(), false)
-                .analyse(&one)
-                .load_factor
-                .unwrap()
-        })
+        .map(|k| factor_at_pose(&weak, &s, k).unwrap())
         .fold(f64::INFINITY, f64::min);
     let lower = a.load_factor_lower.unwrap();
     assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
