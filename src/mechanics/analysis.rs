@@ -236,6 +236,15 @@ struct Judged {
     scale: f64,
 }
 
+impl Judged {
+    /// This verdict and `other`'s, over both sets of links.
+    fn join(&mut self, other: Judged) {
+        self.worst = self.worst.max(other.worst);
+        self.gate = self.gate.max(other.gate);
+        self.scale = self.scale.max(other.scale);
+    }
+}
+
 /// The limit analysis of one component over the poses the screen could not
 /// clear.
 #[derive(Copy, Clone, Debug)]
@@ -1009,11 +1018,17 @@ impl Analyzer {
         for (j, &li) in active.iter().enumerate() {
             slot[li] = j;
         }
+        // A pose's weight of each unit solution.
+        let weights = |pose: Option<usize>| -> Vec<f64> {
+            basis
+                .iter()
+                .map(|(u, _)| u.coordinate(|h| mover_moment(s, h, pose) - references[h]))
+                .collect()
+        };
         // A pose's interface forces superposed from the unit solutions.
         let superposed = |pose: Option<usize>, sf: &mut Vec<Vec6>| {
             sf.clone_from(&sf_reference);
-            for (u, sf_b) in &basis {
-                let c = u.coordinate(|h| mover_moment(s, h, pose) - references[h]);
+            for ((_, sf_b), c) in basis.iter().zip(weights(pose)) {
                 if c != 0.0 {
                     sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                 }
@@ -1064,20 +1079,14 @@ impl Analyzer {
                 }
                 for v in i * per_interval..(i + 1) * per_interval {
                     let pose = Some(n_samples + v);
-                    let cs: Vec<f64> = basis
-                        .iter()
-                        .map(|(u, _)| u.coordinate(|h| mover_moment(s, h, pose) - references[h]))
-                        .collect();
+                    let cs = weights(pose);
                     let mut judged = Judged::default();
                     for &j in &open {
                         let mut f = sf_reference[j];
                         for ((_, sf_b), c) in basis.iter().zip(&cs) {
                             f += *c * sf_b[j];
                         }
-                        let one = self.judge_link(s, active[j], &f);
-                        judged.worst = judged.worst.max(one.worst);
-                        judged.gate = judged.gate.max(one.gate);
-                        judged.scale = judged.scale.max(one.scale);
+                        judged.join(self.judge_link(s, active[j], &f));
                     }
                     screen.between_judged += 1;
                     if overloaded(judged.worst) || overloaded(judged.gate) {
@@ -1506,9 +1515,7 @@ impl Analyzer {
             }
             let l = &s.links[li];
             let one = self.judge_link(s, li, sf(li));
-            j_out.worst = j_out.worst.max(one.worst);
-            j_out.gate = j_out.gate.max(one.gate);
-            j_out.scale = j_out.scale.max(one.scale);
+            j_out.join(one);
             let u = one.worst;
             if first || u > severity(results[j].utilisation) {
                 results[j] = self.link_result(l, sf(li), st.sliding[li]);
@@ -1887,17 +1894,11 @@ impl Analyzer {
         }
     }
 
-    /// The smallest factor over the failing poses by [`sweep_bisection`],
-    /// where it applies: a sweep ([`sweep_bisection::sweep`]) at least
-    /// half of whose poses (its samples and the poses between them) fail
-    /// the screen; the poses it cleared are solved only as corners of a
-    /// run's bound. A load-factor tolerance spares runs too (its bound
-    /// then the lower end).
-    ///
-    /// The first solve runs alone, to learn the solver setting the others
-    /// start from ([`limit::load_factor_from`]); the rest of each batch
-    /// the bisection asks for run in parallel.
-    /// Whether [`Analyzer::bisect`] takes these failing poses.
+    /// Whether [`Analyzer::bisect`] takes these failing poses: a sweep
+    /// ([`sweep_bisection::sweep`]) at least half of whose poses (its
+    /// samples and the poses between them) fail the screen. Where fewer
+    /// fail, solving them (the enumeration, with its elastic bounds)
+    /// costs less than the bisection's corners.
     fn bisection_applies(&self, s: &Structure, failing: &[(Option<usize>, f64)]) -> bool {
         if !self.settings.bisect_sweeps {
             return false;
@@ -1913,9 +1914,19 @@ impl Analyzer {
         2 * wanted >= all
     }
 
-    /// `known`: a pose already solved, and its factor, not solved again.
-    /// Returns the bisection's outcome, the solver setting and how many
-    /// of its solves `known` answered (0 or 1).
+    /// The smallest factor over the failing poses by [`sweep_bisection`],
+    /// where it applies ([`Analyzer::bisection_applies`], which the caller
+    /// asks first); the poses the screen cleared are solved only as
+    /// corners of a run's bound. A load-factor tolerance spares runs too
+    /// (its bound then the lower end).
+    ///
+    /// `known`: a pose the caller solved already, with its factor, not
+    /// solved again; `start`: the solver setting to start from. Without
+    /// `known` the first solve runs alone, to learn the setting the others
+    /// start from ([`limit::load_factor_from`]); the rest of each batch
+    /// the bisection asks for run in parallel. Returns the bisection's
+    /// outcome, the solver setting and how many of its solves `known`
+    /// answered (0 or 1).
     fn bisect(
         &self,
         s: &Structure,
@@ -1924,9 +1935,6 @@ impl Analyzer {
         known: Option<(usize, f64)>,
         start: usize,
     ) -> Option<(sweep_bisection::Outcome, usize, usize)> {
-        if !self.bisection_applies(s, failing) {
-            return None;
-        }
         let sweep = sweep_bisection::sweep(s)?;
         // Each failing pose's elastic bound of 1/λ as a factor (0 without
         // one): a lower end for the runs a failing step leaves open. A
@@ -1934,8 +1942,8 @@ impl Analyzer {
         let mut elastic = vec![None; sweep.n + s.between.len()];
         for &(pose, bound) in failing {
             if let Some(k) = pose.filter(|&k| k < elastic.len()) {
-                let known = bound.is_finite() && bound > 0.0;
-                elastic[k] = Some(if known { 1.0 / bound } else { 0.0 });
+                let bounded = bound.is_finite() && bound > 0.0;
+                elastic[k] = Some(if bounded { 1.0 / bound } else { 0.0 });
             }
         }
         let mut start = start;
