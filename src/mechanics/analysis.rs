@@ -245,6 +245,28 @@ impl Judged {
     }
 }
 
+/// A superposed component's sweep as [`Analyzer::judge_superposed`]
+/// reads it: each active link's slot (indexed by link) in the interface
+/// forces of the reference (`reference`) and of each unit solution
+/// (`basis`), each mover's reference moment, the sampled poses and
+/// whether the poses between them are judged.
+struct SuperposedSweep<'a> {
+    slot: &'a [usize],
+    reference: &'a [Vec6],
+    basis: &'a [(Unit, Vec<Vec6>)],
+    references: &'a [DVec3],
+    samples: usize,
+    between: bool,
+}
+
+/// The elastic verdicts of a component's poses: at each sampled pose, and
+/// at each pose between samples (`None` where its interval's bound cleared
+/// every link; empty where they are not judged).
+struct SweepJudged {
+    at_samples: Vec<Judged>,
+    between: Vec<Option<Judged>>,
+}
+
 /// The limit analysis of one component over the poses the screen could not
 /// clear.
 #[derive(Copy, Clone, Debug)]
@@ -956,7 +978,7 @@ impl Analyzer {
         // most three dimensions however many movers it has
         // (`superposition`): the poses are superposed from a few unit
         // solutions instead of one solve each. Superposition also gives
-        // each interval between samples its bound (`interval_uncleared`),
+        // each interval between samples its bound (`interval_clears`),
         // without which the poses between them go unjudged: where those
         // are enumerated it pays up to one solve per interval more.
         let intervals = if s.between.is_empty() {
@@ -1034,17 +1056,45 @@ impl Analyzer {
                 }
             }
         };
-        // Each pose's interface forces, one at a time (never all stored).
+        // Each pose's verdict. Superposed, link by link (each link's unit
+        // forces read once for every pose and interval); otherwise pose by
+        // pose, each pose's interface forces in turn (never all stored).
         screen.links = vec![LinkResult::default(); links.len()];
-        let mut sf: Vec<Vec6> = Vec::new();
-        for (i, pose) in poses.into_iter().enumerate() {
-            match pose {
-                None => sf.clone_from(&sf_reference),
-                Some(_) if superpose => superposed(pose, &mut sf),
-                Some(_) => sf = sf_of(&solutions[i]),
+        let judged_between = superpose && !s.between.is_empty();
+        let judged = if superpose {
+            let sweep = SuperposedSweep {
+                slot: &slot,
+                reference: &sf_reference,
+                basis: &basis,
+                references: &references,
+                samples: n_samples,
+                between: judged_between,
+            };
+            self.judge_superposed(s, links, &st, &sweep, &mut screen.links)
+        } else {
+            let mut sf: Vec<Vec6> = Vec::new();
+            let mut at_samples = Vec::with_capacity(poses.len());
+            for (i, &pose) in poses.iter().enumerate() {
+                match pose {
+                    None => sf.clone_from(&sf_reference),
+                    Some(_) => sf = sf_of(&solutions[i]),
+                }
+                let sf_link = |li: usize| &sf[slot[li]];
+                at_samples.push(self.judge_pose(
+                    s,
+                    links,
+                    &st,
+                    &sf_link,
+                    i == 0,
+                    &mut screen.links,
+                ));
             }
-            let sf_link = |li: usize| &sf[slot[li]];
-            let judged = self.judge_pose(s, links, &st, &sf_link, i == 0, &mut screen.links);
+            SweepJudged {
+                at_samples,
+                between: Vec::new(),
+            }
+        };
+        for (&pose, judged) in poses.iter().zip(&judged.at_samples) {
             if overloaded(judged.worst) || overloaded(judged.gate) {
                 // Branch and bound needs an upper bound of 1/λ: the
                 // utilisation where the corners carry the forces, else the
@@ -1056,7 +1106,6 @@ impl Analyzer {
                 screen.admissible = screen.admissible.max(judged.worst);
             }
         }
-        let judged_between = superpose && !s.between.is_empty();
         if n_samples > 1 && self.settings.envelope && !judged_between {
             screen.sampled_only = Some(if superpose {
                 SampledOnly::TurningRates { groups: s.groups() }
@@ -1066,35 +1115,17 @@ impl Analyzer {
                 }
             });
         }
-        if judged_between {
-            // Between samples: the poses of `Structure::between` are judged
-            // for the verdict at the links whose loads there may reach the
-            // corner gate (the others stay below it at every such pose).
-            let per_interval = s.between.len() / (n_samples - 1);
-            for i in 0..n_samples - 1 {
-                let open =
-                    self.interval_uncleared(s, &active, &sf_reference, &basis, &references, i);
-                if open.is_empty() {
-                    continue;
-                }
-                for v in i * per_interval..(i + 1) * per_interval {
-                    let pose = Some(n_samples + v);
-                    let cs = weights(pose);
-                    let mut judged = Judged::default();
-                    for &j in &open {
-                        let mut f = sf_reference[j];
-                        for ((_, sf_b), c) in basis.iter().zip(&cs) {
-                            f += *c * sf_b[j];
-                        }
-                        judged.join(self.judge_link(s, active[j], &f));
-                    }
-                    screen.between_judged += 1;
-                    if overloaded(judged.worst) || overloaded(judged.gate) {
-                        screen
-                            .failing
-                            .push((pose, judged.worst.max(severity(judged.scale))));
-                    }
-                }
+        // Between samples: the poses of `Structure::between`, judged for the
+        // verdict at the links whose loads there may reach the corner gate
+        // (`None`: every link stays below it at every pose of the interval).
+        for (v, judged) in judged.between.iter().enumerate() {
+            let Some(judged) = judged else { continue };
+            screen.between_judged += 1;
+            if overloaded(judged.worst) || overloaded(judged.gate) {
+                screen.failing.push((
+                    Some(n_samples + v),
+                    judged.worst.max(severity(judged.scale)),
+                ));
             }
         }
         screen.failing.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -1593,69 +1624,152 @@ impl Analyzer {
         j_out
     }
 
-    /// The links (positions in `active`) that one bound does not clear at
-    /// every pose between samples `i` and `i + 1`: a pose there moves each
-    /// group of movers to sample `i + 1` or to the tangent point, which
-    /// adds to each link's load at sample `i` the group's share of the
-    /// change; with every component of those shares at its largest
-    /// magnitude (the utilisation grows with each of the tension, shear,
-    /// torsion and bending magnitudes), a cleared link stays below the
+    /// The screen of a superposed component (see [`Analyzer::screen`]):
+    /// each sampled pose's verdict and, with `sweep.between`, each pose
+    /// between samples' verdict, in one pass over the links. Every link's
+    /// unit forces are read once for all poses (pose by pose, a step of a
+    /// 30,000-module scaffold read them some fifty times); each figure is
+    /// the one a pose-by-pose pass computes, in the same order.
+    ///
+    /// Between samples `i` and `i + 1` a pose moves each group of movers to
+    /// sample `i + 1` or to the tangent point, which adds to each link's
+    /// load at sample `i` the group's share of the change. With every
+    /// component of those shares at its largest magnitude (the utilisation
+    /// grows with each of the tension, shear, torsion and bending
+    /// magnitudes), a link cleared by that bound stays below the
     /// utilisation at which the corner construction always carries it
-    /// (`CORNER_FREE_BELOW`): an elastic witness at every such pose, so
-    /// only the others are judged there. `basis`: per unit solution its
-    /// unit and interface forces (of the `active` links); `references`:
-    /// each mover's reference moment.
-    fn interval_uncleared(
+    /// (`CORNER_FREE_BELOW`): an elastic witness at every such pose. Only
+    /// the other links are judged at the interval's poses; an interval
+    /// whose links are all cleared has no verdicts (`None`).
+    fn judge_superposed(
         &self,
         s: &Structure,
-        active: &[usize],
-        sf_reference: &[Vec6],
-        basis: &[(Unit, Vec<Vec6>)],
-        references: &[DVec3],
-        i: usize,
-    ) -> Vec<usize> {
-        let groups = s.groups();
-        let zero = vec![Vec6::zeros(); active.len()];
-        let mut at_i = sf_reference.to_vec();
-        let mut share = vec![[zero.clone(), zero]; groups];
-        for (u, sf_b) in basis {
-            let at = |point: &dyn Fn(&Hanging) -> DVec3| {
-                u.coordinate(|h| moment_at(s, h, point(&s.hanging[h])) - references[h])
-            };
-            let c = at(&|hg| hg.path[i]);
-            let c1 = at(&|hg| hg.path[i + 1]) - c;
-            let ct = at(&|hg| hg.hull[i]) - c;
-            let [to_next, to_tangent] = &mut share[u.group];
-            for (j, y) in sf_b.iter().enumerate() {
-                at_i[j] += c * y;
-                to_next[j] += c1 * y;
-                to_tangent[j] += ct * y;
+        links: &[usize],
+        st: &Settled,
+        sweep: &SuperposedSweep<'_>,
+        results: &mut [LinkResult],
+    ) -> SweepJudged {
+        let (basis, n) = (sweep.basis, sweep.samples);
+        let coordinate = |u: &Unit, point: &dyn Fn(&Hanging) -> DVec3| {
+            u.coordinate(|h| moment_at(s, h, point(&s.hanging[h])) - sweep.references[h])
+        };
+        // A pose's weight of each unit solution.
+        let weights = |pose: usize| -> Vec<f64> {
+            basis
+                .iter()
+                .map(|(u, _)| {
+                    u.coordinate(|h| mover_moment(s, h, Some(pose)) - sweep.references[h])
+                })
+                .collect()
+        };
+        let at_samples: Vec<Vec<f64>> = (0..n).map(weights).collect();
+        let intervals = if sweep.between {
+            n.saturating_sub(1)
+        } else {
+            0
+        };
+        let per_interval = s.between.len().checked_div(intervals).unwrap_or(0);
+        let at_between: Vec<Vec<f64>> = (0..intervals * per_interval)
+            .map(|v| weights(n + v))
+            .collect();
+        // Per interval and unit: its group, its weight at sample `i`, and
+        // the changes of that weight to sample `i + 1` and to the tangent
+        // point.
+        let bounds: Vec<Vec<(usize, f64, f64, f64)>> = (0..intervals)
+            .map(|i| {
+                basis
+                    .iter()
+                    .map(|(u, _)| {
+                        let c = coordinate(u, &|hg| hg.path[i]);
+                        let c1 = coordinate(u, &|hg| hg.path[i + 1]) - c;
+                        let ct = coordinate(u, &|hg| hg.hull[i]) - c;
+                        (u.group, c, c1, ct)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out = SweepJudged {
+            at_samples: vec![Judged::default(); n],
+            between: vec![None; at_between.len()],
+        };
+        let mut share = vec![[Vec6::zeros(); 2]; s.groups()];
+        for (j, &li) in links.iter().enumerate() {
+            if st.released[li] {
+                results[j] = LinkResult {
+                    released: true,
+                    ..Default::default()
+                };
+                continue;
+            }
+            let (l, a) = (&s.links[li], sweep.slot[li]);
+            let reference = sweep.reference[a];
+            for (i, cs) in at_samples.iter().enumerate() {
+                let mut f = reference;
+                for ((_, sf_b), &c) in basis.iter().zip(cs) {
+                    if c != 0.0 {
+                        f += c * sf_b[a];
+                    }
+                }
+                let one = self.judge_link(s, li, &f);
+                out.at_samples[i].join(one);
+                if i == 0 || one.worst > severity(results[j].utilisation) {
+                    results[j] = self.link_result(l, &f, st.sliding[li]);
+                }
+            }
+            for (i, bound) in bounds.iter().enumerate() {
+                let mut at_i = reference;
+                share.fill([Vec6::zeros(); 2]);
+                for (&(group, c, c1, ct), (_, sf_b)) in bound.iter().zip(basis) {
+                    let y = &sf_b[a];
+                    at_i += c * y;
+                    let [to_next, to_tangent] = &mut share[group];
+                    *to_next += c1 * y;
+                    *to_tangent += ct * y;
+                }
+                if self.interval_clears(l, &at_i, &share) {
+                    continue;
+                }
+                let poses = i * per_interval..(i + 1) * per_interval;
+                for (cs, judged) in at_between[poses.clone()]
+                    .iter()
+                    .zip(&mut out.between[poses])
+                {
+                    let mut f = reference;
+                    for ((_, sf_b), c) in basis.iter().zip(cs) {
+                        f += *c * sf_b[a];
+                    }
+                    judged
+                        .get_or_insert_with(Judged::default)
+                        .join(self.judge_link(s, li, &f));
+                }
             }
         }
-        (0..active.len())
-            .filter(|&j| {
-                let li = active[j];
-                let l = &s.links[li];
-                let base = self.load_of(l, &at_i[j]).0;
-                let mut worst = ConnectorLoad {
-                    axial: base.axial,
-                    shear: base.shear,
-                    torsion: base.torsion.abs(),
-                    moment_u: base.moment_u.abs(),
-                    moment_v: base.moment_v.abs(),
-                };
-                for [a, b] in &share {
-                    let (a, b) = (self.load_of(l, &a[j]).0, self.load_of(l, &b[j]).0);
-                    worst.axial += a.axial.abs().max(b.axial.abs());
-                    worst.shear += a.shear.max(b.shear);
-                    worst.torsion += a.torsion.abs().max(b.torsion.abs());
-                    worst.moment_u += a.moment_u.abs().max(b.moment_u.abs());
-                    worst.moment_v += a.moment_v.abs().max(b.moment_v.abs());
-                }
-                // (NaN ranks above every finite utilisation: not cleared.)
-                severity(utilisation(&worst, self.capacity(l)).0) > CORNER_FREE_BELOW
-            })
-            .collect()
+        out
+    }
+
+    /// Whether link `l`, loaded by `at_i` at a sample and by up to one of
+    /// each group's two `share`s more between it and the next sample,
+    /// stays below `CORNER_FREE_BELOW` whatever the shares' signs (see
+    /// [`Analyzer::judge_superposed`]).
+    fn interval_clears(&self, l: &Link, at_i: &Vec6, share: &[[Vec6; 2]]) -> bool {
+        let base = self.load_of(l, at_i).0;
+        let mut worst = ConnectorLoad {
+            axial: base.axial,
+            shear: base.shear,
+            torsion: base.torsion.abs(),
+            moment_u: base.moment_u.abs(),
+            moment_v: base.moment_v.abs(),
+        };
+        for [a, b] in share {
+            let (a, b) = (self.load_of(l, a).0, self.load_of(l, b).0);
+            worst.axial += a.axial.abs().max(b.axial.abs());
+            worst.shear += a.shear.max(b.shear);
+            worst.torsion += a.torsion.abs().max(b.torsion.abs());
+            worst.moment_u += a.moment_u.abs().max(b.moment_u.abs());
+            worst.moment_v += a.moment_v.abs().max(b.moment_v.abs());
+        }
+        // (NaN ranks above every finite utilisation: not cleared.)
+        severity(utilisation(&worst, self.capacity(l)).0) <= CORNER_FREE_BELOW
     }
 
     /// One link's result from its interface force `sf` (units `W`, `W·d`).
