@@ -654,6 +654,20 @@ fn mover_moment(s: &Structure, h: usize, pose: Option<usize>) -> DVec3 {
 }
 
 /// `acc += w · x`, `acc` taking `x`'s length when empty.
+/// A pose's weight of each unit solution of `basis` (`references`: each
+/// mover's reference moment).
+fn unit_weights(
+    s: &Structure,
+    basis: &[(Unit, Vec<Vec6>)],
+    references: &[DVec3],
+    pose: Option<usize>,
+) -> Vec<f64> {
+    basis
+        .iter()
+        .map(|(u, _)| u.coordinate(|h| mover_moment(s, h, pose) - references[h]))
+        .collect()
+}
+
 fn add_scaled(acc: &mut Vec<Vec6>, x: &[Vec6], w: f64) {
     if acc.is_empty() {
         acc.resize(x.len(), Vec6::zeros());
@@ -1040,17 +1054,10 @@ impl Analyzer {
         for (j, &li) in active.iter().enumerate() {
             slot[li] = j;
         }
-        // A pose's weight of each unit solution.
-        let weights = |pose: Option<usize>| -> Vec<f64> {
-            basis
-                .iter()
-                .map(|(u, _)| u.coordinate(|h| mover_moment(s, h, pose) - references[h]))
-                .collect()
-        };
         // A pose's interface forces superposed from the unit solutions.
         let superposed = |pose: Option<usize>, sf: &mut Vec<Vec6>| {
             sf.clone_from(&sf_reference);
-            for ((_, sf_b), c) in basis.iter().zip(weights(pose)) {
+            for ((_, sf_b), c) in basis.iter().zip(unit_weights(s, &basis, &references, pose)) {
                 if c != 0.0 {
                     sf.iter_mut().zip(sf_b).for_each(|(x, y)| *x += c * y);
                 }
@@ -1544,15 +1551,28 @@ impl Analyzer {
                 }
                 continue;
             }
-            let l = &s.links[li];
-            let one = self.judge_link(s, li, sf(li));
-            j_out.join(one);
-            let u = one.worst;
-            if first || u > severity(results[j].utilisation) {
-                results[j] = self.link_result(l, sf(li), st.sliding[li]);
-            }
+            j_out.join(self.judge_into(s, li, sf(li), first, st.sliding[li], &mut results[j]));
         }
         j_out
+    }
+
+    /// Link `li` judged at one pose from its interface force `f`; `result`,
+    /// its worst result over the poses so far, is replaced at the first
+    /// pose or where this one loads it more.
+    fn judge_into(
+        &self,
+        s: &Structure,
+        li: usize,
+        f: &Vec6,
+        first: bool,
+        sliding: bool,
+        result: &mut LinkResult,
+    ) -> Judged {
+        let one = self.judge_link(s, li, f);
+        if first || one.worst > severity(result.utilisation) {
+            *result = self.link_result(&s.links[li], f, sliding);
+        }
+        one
     }
 
     /// The largest multiple of link `li`'s elastic action (interface force
@@ -1653,15 +1673,7 @@ impl Analyzer {
         let coordinate = |u: &Unit, point: &dyn Fn(&Hanging) -> DVec3| {
             u.coordinate(|h| moment_at(s, h, point(&s.hanging[h])) - sweep.references[h])
         };
-        // A pose's weight of each unit solution.
-        let weights = |pose: usize| -> Vec<f64> {
-            basis
-                .iter()
-                .map(|(u, _)| {
-                    u.coordinate(|h| mover_moment(s, h, Some(pose)) - sweep.references[h])
-                })
-                .collect()
-        };
+        let weights = |pose: usize| unit_weights(s, basis, sweep.references, Some(pose));
         let at_samples: Vec<Vec<f64>> = (0..n).map(weights).collect();
         let intervals = if sweep.between {
             n.saturating_sub(1)
@@ -1710,11 +1722,8 @@ impl Analyzer {
                         f += c * sf_b[a];
                     }
                 }
-                let one = self.judge_link(s, li, &f);
+                let one = self.judge_into(s, li, &f, i == 0, st.sliding[li], &mut results[j]);
                 out.at_samples[i].join(one);
-                if i == 0 || one.worst > severity(results[j].utilisation) {
-                    results[j] = self.link_result(l, &f, st.sliding[li]);
-                }
             }
             for (i, bound) in bounds.iter().enumerate() {
                 let mut at_i = reference;
