@@ -1867,7 +1867,7 @@ impl Analyzer {
         // again.
         let mut probed = None;
         let mut start = self.limit_setting;
-        if self.bisection_applies(s, failing)
+        if let Some(sweep) = self.bisection_sweep(s, failing)
             && let Some(i0) = (0..failing.len()).find(|&i| !dominated[i])
         {
             let r = solve_pose(failing[i0].0, start);
@@ -1876,17 +1876,15 @@ impl Analyzer {
             }
             if !fails(r.0.lambda) {
                 let known = failing[i0].0.map(|k| (k, r.0.lambda));
-                if let Some((bisected, setting, reused)) =
-                    self.bisect(s, part, failing, known, start)
-                {
-                    out.capacities = bisected.smallest;
-                    out.lower = bisected.lower;
-                    out.partial = bisected.partial;
-                    out.runs = bisected.solves + 1 - reused;
-                    out.setting = setting;
-                    self.rigid(s, part, failing, &mut out);
-                    return out;
-                }
+                let (bisected, setting, reused) =
+                    self.bisect(s, &sweep, part, failing, known, start);
+                out.capacities = bisected.smallest;
+                out.lower = bisected.lower;
+                out.partial = bisected.partial;
+                out.runs = bisected.solves + 1 - reused;
+                out.setting = setting;
+                self.rigid(s, part, failing, &mut out);
+                return out;
             }
             probed = Some((i0, r));
         }
@@ -2017,29 +2015,31 @@ impl Analyzer {
         }
     }
 
-    /// Whether [`Analyzer::bisect`] takes these failing poses: a sweep
-    /// ([`sweep_bisection::sweep`]) at least half of whose poses (its
-    /// samples and the poses between them) fail the screen. Where fewer
-    /// fail, solving them (the enumeration, with its elastic bounds)
-    /// costs less than the bisection's corners.
-    fn bisection_applies(&self, s: &Structure, failing: &[(Option<usize>, f64)]) -> bool {
+    /// The sweep ([`sweep_bisection::sweep`]) for [`Analyzer::bisect`]
+    /// to take these failing poses, where the step is one and at least
+    /// half of its poses (its samples and the poses between them) fail
+    /// the screen. Where fewer fail, solving them (the enumeration, with
+    /// its elastic bounds) costs less than the bisection's corners.
+    fn bisection_sweep(
+        &self,
+        s: &Structure,
+        failing: &[(Option<usize>, f64)],
+    ) -> Option<sweep_bisection::Sweep> {
         if !self.settings.bisect_sweeps {
-            return false;
+            return None;
         }
-        let Some(sweep) = sweep_bisection::sweep(s) else {
-            return false;
-        };
+        let sweep = sweep_bisection::sweep(s)?;
         let all = sweep.n + s.between.len();
         let wanted = failing
             .iter()
             .filter(|(p, _)| p.is_some_and(|k| k < all))
             .count();
-        2 * wanted >= all
+        (2 * wanted >= all).then_some(sweep)
     }
 
-    /// The smallest factor over the failing poses by [`sweep_bisection`],
-    /// where it applies ([`Analyzer::bisection_applies`], which the caller
-    /// asks first); the poses the screen cleared are solved only as
+    /// The smallest factor over the failing poses of `sweep` by
+    /// [`sweep_bisection`] ([`Analyzer::bisection_sweep`] says where it
+    /// applies); the poses the screen cleared are solved only as
     /// corners of a run's bound. A load-factor tolerance spares runs too
     /// (its bound then the lower end).
     ///
@@ -2053,12 +2053,12 @@ impl Analyzer {
     fn bisect(
         &self,
         s: &Structure,
+        sweep: &sweep_bisection::Sweep,
         part: limit::Part<'_>,
         failing: &[(Option<usize>, f64)],
         known: Option<(usize, f64)>,
         start: usize,
-    ) -> Option<(sweep_bisection::Outcome, usize, usize)> {
-        let sweep = sweep_bisection::sweep(s)?;
+    ) -> (sweep_bisection::Outcome, usize, usize) {
         // Each failing pose's elastic bound of 1/λ as a factor (0 without
         // one): a lower end for the runs a failing step leaves open. A
         // pose the screen cleared stays None: not wanted.
@@ -2114,8 +2114,8 @@ impl Analyzer {
         };
         let floor = |k: usize| elastic[k];
         let tolerance = self.settings.load_factor_tolerance;
-        let outcome = sweep_bisection::smallest_factor(s, &sweep, &mut solve, &floor, tolerance);
-        Some((outcome, start, reused.into_inner()))
+        let outcome = sweep_bisection::smallest_factor(s, sweep, &mut solve, &floor, tolerance);
+        (outcome, start, reused.into_inner())
     }
 
     /// The bound by which the fields solved so far prove that `pose`
