@@ -14,6 +14,7 @@ pub(crate) mod lattice_check;
 pub(crate) mod load_check;
 pub mod meta_check;
 pub(crate) mod report;
+pub(crate) mod window;
 pub(crate) mod world;
 
 pub use baseline::{Comparison, Rise, compare as compare_with_baseline, load as load_baseline};
@@ -23,6 +24,7 @@ pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
 pub use load_check::{LoadCheck, RangedReplay, load_maps_at, replay, replay_ranged};
 pub use report::{Report, Severity, StepResult, Violation, ViolationKind};
+pub use window::window;
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;

@@ -175,6 +175,11 @@ impl World {
         self.sinks.contains(&c)
     }
 
+    /// How many pairs of touching modules are detached now.
+    pub fn detached_pairs(&self) -> usize {
+        self.detached.len()
+    }
+
     pub fn latched(&self, a: ModuleId, b: ModuleId) -> bool {
         !self.detached.contains(&pair(a, b))
     }

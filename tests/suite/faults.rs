@@ -42,8 +42,9 @@ fn two_movers_ending_in_one_cell_are_an_occupancy_violation() {
     assert_eq!(r.stopped_at, Some(1));
 }
 
-#[test]
-fn a_mover_whose_latch_to_the_pivot_is_released_is_detached() {
+/// Module 100 on the platform, its latch to platform module 3 released
+/// at step 1.
+fn with_a_released_latch() -> Schedule {
     let mut s = fcc_platform();
     add(&mut s, 100, Cell::new(0, 0, 1));
     step(
@@ -53,6 +54,12 @@ fn a_mover_whose_latch_to_the_pivot_is_released_is_detached() {
             other: 3,
         }],
     );
+    s
+}
+
+#[test]
+fn a_mover_whose_latch_to_the_pivot_is_released_is_detached() {
+    let mut s = with_a_released_latch();
     step(
         &mut s,
         vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
@@ -60,6 +67,35 @@ fn a_mover_whose_latch_to_the_pivot_is_released_is_detached() {
     let r = lattice_report(&s);
     assert_eq!(kinds(&r), vec![(MoverDetached, 2)]);
     assert_eq!(r.violations[0].modules, vec![100, 3]);
+}
+
+/// A window (`certify::window`) cannot start where a latch is released:
+/// a schedule's initial configuration latches every touching pair.
+#[test]
+fn a_window_that_starts_with_a_released_latch_is_refused() {
+    let mut s = with_a_released_latch();
+    step(
+        &mut s,
+        vec![Event::Attach {
+            module: 100,
+            other: 3,
+        }],
+    );
+    step(
+        &mut s,
+        vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
+    );
+    let e = reconfcheck::certify::window(&s, 1, 2)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("after step 1, 1 pairs of modules are detached"),
+        "{e}"
+    );
+    // Latched again after step 2, and at the start: both windows stand.
+    let w = reconfcheck::certify::window(&s, 2, 1).unwrap();
+    assert_eq!(kinds(&lattice_report(&w)), vec![]);
+    assert!(reconfcheck::certify::window(&s, 0, 3).is_ok());
 }
 
 #[test]
