@@ -18,7 +18,7 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let made = Schedule::load(std::path::Path::new(path))
-        .and_then(|s| reconfcheck::certify::window(&s, start, count));
+        .and_then(|s| reconfcheck::certify::window(s, start, count));
     match made {
         Ok(w) => match std::fs::write(out, w.to_json()) {
             Ok(()) => ExitCode::SUCCESS,

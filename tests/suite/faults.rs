@@ -85,7 +85,7 @@ fn a_window_that_starts_with_a_released_latch_is_refused() {
         &mut s,
         vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
     );
-    let e = reconfcheck::certify::window(&s, 1, 2)
+    let e = reconfcheck::certify::window(s.clone(), 1, 2)
         .unwrap_err()
         .to_string();
     assert!(
@@ -93,9 +93,9 @@ fn a_window_that_starts_with_a_released_latch_is_refused() {
         "{e}"
     );
     // Latched again after step 2, and at the start: both windows stand.
-    let w = reconfcheck::certify::window(&s, 2, 1).unwrap();
+    let w = reconfcheck::certify::window(s.clone(), 2, 1).unwrap();
     assert_eq!(kinds(&lattice_report(&w)), vec![]);
-    assert!(reconfcheck::certify::window(&s, 0, 3).is_ok());
+    assert!(reconfcheck::certify::window(s, 0, 3).is_ok());
 }
 
 #[test]
