@@ -626,6 +626,7 @@ pub fn certify_atoms(s: &Schedule, rest: AtomRest, opts: &Options) -> Result<Rep
         final_modules: s.modules.len(),
         steps: s.steps.len(),
         moves: operations,
+        window: None,
         checks: names,
         load_factor_tolerance: 0.0,
         certified: false,

@@ -83,10 +83,12 @@ fn rose(before: f64, after: f64, tolerance: f64) -> bool {
     !(after.is_finite() && after <= before + tolerance)
 }
 
-/// The peak of a report's per-step utilisations (NaN ranks highest).
-fn peak(r: &Report) -> Option<f64> {
+/// The peak of a report's per-step utilisations at the steps `within`
+/// holds (NaN ranks highest).
+fn peak(r: &Report, within: impl Fn(usize) -> bool) -> Option<f64> {
     r.per_step
         .iter()
+        .filter(|s| within(s.step))
         .filter_map(|s| s.metrics.get(UTILISATION).copied())
         .map(crate::mechanics::severity)
         .reduce(f64::max)
@@ -96,8 +98,16 @@ fn peak(r: &Report) -> Option<f64> {
 /// utilisation (a fraction of capacity) still accepted.
 pub fn compare(current: &Report, baseline: &Report, tolerance: f64) -> Comparison {
     let mut out = Comparison::default();
+    // Where the current report checked part of the schedule (`--steps`),
+    // the baseline's findings elsewhere are neither fixed nor compared.
+    let within = |step: usize| current.window.is_none_or(|w| w.holds(step, current.steps));
+    let baseline_violations: Vec<&Violation> = baseline
+        .violations
+        .iter()
+        .filter(|v| within(v.step))
+        .collect();
     let mut remaining: BTreeMap<Key, usize> = BTreeMap::new();
-    for v in &baseline.violations {
+    for v in &baseline_violations {
         *remaining.entry(key(v)).or_insert(0) += 1;
     }
     for v in &current.violations {
@@ -110,7 +120,7 @@ pub fn compare(current: &Report, baseline: &Report, tolerance: f64) -> Compariso
         }
     }
     let mut unmatched = remaining;
-    for v in &baseline.violations {
+    for v in baseline_violations {
         if let Some(n) = unmatched.get_mut(&key(v))
             && *n > 0
         {
@@ -134,7 +144,7 @@ pub fn compare(current: &Report, baseline: &Report, tolerance: f64) -> Compariso
             });
         }
     }
-    if let (Some(b), Some(a)) = (peak(baseline), peak(current))
+    if let (Some(b), Some(a)) = (peak(baseline, within), peak(current, |_| true))
         && rose(b, a, tolerance)
     {
         out.rises.push(Rise {
@@ -188,6 +198,7 @@ mod tests {
             final_modules: 5,
             steps: utilisations.len(),
             moves: 0,
+            window: None,
             checks: vec![],
             load_factor_tolerance: 0.0,
             certified: violations.is_empty(),
@@ -227,6 +238,33 @@ mod tests {
         // Within the tolerance is no rise.
         let cur = report(vec![], &[0.5, 0.6005]);
         assert!(compare(&cur, &old, 1e-3).rises.is_empty());
+    }
+
+    #[test]
+    fn a_span_of_steps_is_compared_with_the_baseline_there_only() {
+        // The whole run: findings at steps 1 and 3, its peak at step 1.
+        let old = report(
+            vec![collision(1, 1, 2), collision(3, 3, 4)],
+            &[0.9, 0.5, 0.6, 0.4],
+        );
+        // Steps 2-3 checked (`--steps 2-3`), with the same finding at 3:
+        // step 1's is not fixed, and the peak is step 3's, not 0.9.
+        let mut cur = report(vec![collision(3, 3, 4)], &[0.5, 0.6]);
+        cur.steps = 4;
+        cur.window = Some(crate::certify::StepSpan { first: 2, last: 3 });
+        for s in &mut cur.per_step {
+            s.step += 1;
+        }
+        let c = compare(&cur, &old, 1e-3);
+        assert_eq!((c.known, c.fixed.len(), c.new.len()), (1, 0, 0), "{c:?}");
+        assert!(!c.regressed());
+        // A rise there is still one, at the step and as the span's peak.
+        cur.per_step[1].metrics.insert(UTILISATION.into(), 0.7);
+        let c = compare(&cur, &old, 1e-3);
+        assert_eq!(c.rises.len(), 2, "{c:?}");
+        // And the finding fixed there is fixed.
+        cur.violations.clear();
+        assert_eq!(compare(&cur, &old, 1e-3).fixed.len(), 1);
     }
 
     #[test]

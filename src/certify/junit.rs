@@ -98,9 +98,16 @@ pub fn to_junit(report: &Report) -> String {
             case.push_attribute(("name", name.as_str()));
             w.write_event(Event::Start(case))
                 .expect("writing to memory");
-            if step > stopped {
+            let why = if step > stopped {
+                Some(format!("not checked: the replay stopped at step {stopped}"))
+            } else {
+                report
+                    .window
+                    .filter(|w| !w.holds(step, report.steps))
+                    .map(|w| format!("not checked: outside --steps {}-{}", w.first, w.last))
+            };
+            if let Some(why) = why {
                 let mut skipped = BytesStart::new("skipped");
-                let why = format!("not checked: the replay stopped at step {stopped}");
                 skipped.push_attribute(("message", why.as_str()));
                 w.write_event(Event::Empty(skipped))
                     .expect("writing to memory");
@@ -129,6 +136,7 @@ pub fn to_junit(report: &Report) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::certify::StepSpan;
 
     /// Reads back, with an independent parser, (element, attributes) of
     /// every element in document order, and the text inside failures.
@@ -169,6 +177,7 @@ mod tests {
             final_modules: 10,
             steps: 3,
             moves: 3,
+            window: None,
             checks: vec!["lattice".into(), "collision".into()],
             load_factor_tolerance: 0.0,
             certified: false,
@@ -215,6 +224,36 @@ mod tests {
             skipped,
             2 * 2,
             "step 3 and the final configuration, per check"
+        );
+    }
+
+    #[test]
+    fn steps_outside_a_window_are_skipped_not_passed() {
+        // Steps 2-3 of 3 checked: the initial configuration and step 1
+        // were replayed unchecked; the final one was checked.
+        let skipped_cases = |r: &Report| {
+            let (tags, _) = parse(&to_junit(r));
+            let mut out = Vec::new();
+            for (i, t) in tags.iter().enumerate() {
+                if t.0 == "skipped" {
+                    let name = tags[i - 1].1.iter().find(|a| a.0 == "name").unwrap();
+                    out.push(name.1.clone());
+                }
+            }
+            out
+        };
+        let mut r = report();
+        r.window = Some(StepSpan { first: 2, last: 3 });
+        assert_eq!(
+            skipped_cases(&r),
+            ["initial configuration", "step 1"].repeat(2)
+        );
+        // Steps 1-2: the initial configuration checked, step 3 and the
+        // final one not.
+        r.window = Some(StepSpan { first: 1, last: 2 });
+        assert_eq!(
+            skipped_cases(&r),
+            ["step 3", "final configuration"].repeat(2)
         );
     }
 }

@@ -23,8 +23,8 @@ pub use docking_check::DockingCheck;
 pub use junit::{check_of, to_junit};
 pub use lattice_check::LatticeCheck;
 pub use load_check::{LoadCheck, RangedReplay, load_maps_at, replay, replay_ranged};
-pub use report::{Report, Severity, StepResult, Violation, ViolationKind};
-pub use window::window;
+pub use report::{Report, Severity, StepResult, StepSpan, Violation, ViolationKind};
+pub use window::{StepRequest, window};
 pub use world::{Move, StepPlan, World};
 
 use crate::error::InputError;
@@ -66,6 +66,9 @@ pub struct Options {
     /// A meta-module schedule is certified at the meta-module level only
     /// ([`meta_check`]), not expanded into atom operations.
     pub meta_level: bool,
+    /// Check only these steps (`--steps`), replaying the ones before them
+    /// without checks; `None` checks every step.
+    pub steps: Option<StepRequest>,
 }
 
 /// A range of steps that has been checked, and how long it took.
@@ -104,6 +107,7 @@ impl Default for Options {
             range_done: None,
             load_factor_tolerance: 0.0,
             meta_level: false,
+            steps: None,
         }
     }
 }
@@ -286,6 +290,11 @@ pub fn certify_by(
     opts: &Options,
     runner: &dyn RangeRunner,
 ) -> Result<Report, InputError> {
+    if opts.steps.is_some() && (schedule.atoms.is_some() || schedule.meta_modules.is_some()) {
+        return Err(InputError::new(
+            "--steps applies to schedules of modules; atom and meta-module schedules (seed 004) are certified whole",
+        ));
+    }
     if let Some(rest) = schedule.atoms {
         return atom_check::certify_atoms(schedule, rest, opts);
     }
@@ -356,41 +365,62 @@ pub fn certify_on(
     runner: &dyn RangeRunner,
 ) -> Result<Report, InputError> {
     let mut world = World::initial(schedule)?;
-    let range = range_steps(opts, schedule.steps.len());
+    let n = schedule.steps.len();
+    let window = opts.steps.map(|r| r.within(n)).transpose()?.flatten();
+    // 0-based steps `from..to` are checked.
+    let (from, to) = window.map_or((0, n), |w| (w.first - 1, w.last));
+    let range = range_steps(opts, to - from);
     let (ranged, inline): (Vec<&dyn StepCheck>, Vec<&dyn StepCheck>) = checks
         .iter()
         .copied()
         .partition(|c| range > 0 && c.ranged());
     let mut report = empty_report(schedule, opts, checks);
+    report.window = window;
     let passes = if ranged.is_empty() { 1 } else { 2 };
     let bar = &opts.progress;
-    bar.start("certifying", (passes * schedule.steps.len()) as u64);
+    bar.start("certifying", (passes * (to - from)) as u64);
 
-    // The initial configuration must stand on its own.
-    let loose = world.check_anchored();
-    if !loose.is_empty() {
-        report.violations.push(disconnected(0, "initial", loose));
+    if from == 0 {
+        // The initial configuration must stand on its own.
+        let loose = world.check_anchored();
+        if !loose.is_empty() {
+            report
+                .violations
+                .push(disconnected(0, "initial configuration", loose));
+        }
+    } else if !replay_to(&mut world, schedule, from, &mut report)? {
+        bar.finish();
+        return Ok(report);
     }
     let range_len = if ranged.is_empty() { 0 } else { range };
-    let starts = one_pass(&mut world, schedule, &inline, range_len, &mut report, bar)?;
+    let steps = from..to;
+    let starts = one_pass(
+        &mut world,
+        schedule,
+        steps,
+        &inline,
+        range_len,
+        &mut report,
+        bar,
+    )?;
     if !ranged.is_empty() {
         let jobs = Ranges {
             schedule,
             checks: &ranged,
             starts: &starts,
             range,
-            last: report.per_step.len(),
+            last: from + report.per_step.len(),
             bar,
             done: opts.range_done,
         };
         let mut outcomes = runner.run(&jobs)?;
         outcomes.sort_by_key(|(k, _)| *k);
-        merge(&mut report, outcomes);
+        merge(&mut report, from, outcomes);
     }
     bar.finish();
 
-    if report.stopped_at.is_none() {
-        final_checks(&mut world, schedule.steps.len() + 1, checks, &mut report);
+    if report.stopped_at.is_none() && to == n {
+        final_checks(&mut world, n + 1, checks, &mut report);
     }
     report.certified = report.violations.is_empty() && report.stopped_at.is_none();
     Ok(report)
@@ -488,6 +518,34 @@ impl RangeRunner for Threads {
     }
 }
 
+/// Replays the first `steps` steps without checks (`--steps` starts
+/// later). A step that leaves two modules in one cell stops the replay,
+/// its clash reported. Then the configuration reached must stand on its
+/// own, as the initial one must: unchecked steps cannot vouch for it (nor
+/// be taken to keep it anchored, which the connectivity search's shortcut
+/// relies on). Returns whether the replay reached the first step to check.
+fn replay_to(
+    world: &mut World,
+    schedule: &Schedule,
+    steps: usize,
+    report: &mut Report,
+) -> Result<bool, InputError> {
+    for k in 0..steps {
+        let (_, _, clashes) = advance(world, schedule, k, |_| ())?;
+        if !clashes.is_empty() {
+            report.violations.extend(clashes);
+            report.stopped_at = Some(k + 1);
+            return Ok(false);
+        }
+    }
+    let loose = world.check_anchored();
+    if !loose.is_empty() {
+        let which = format!("configuration after step {steps}, where --steps starts,");
+        report.violations.push(disconnected(steps, &which, loose));
+    }
+    Ok(true)
+}
+
 /// A report with its header filled in and nothing found yet.
 fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) -> Report {
     Report {
@@ -499,6 +557,7 @@ fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) 
         final_modules: schedule.final_module_count(),
         steps: schedule.steps.len(),
         moves: schedule.move_count(),
+        window: None,
         checks: checks.iter().map(|c| c.name().to_string()).collect(),
         load_factor_tolerance: opts.load_factor_tolerance,
         certified: false,
@@ -509,14 +568,14 @@ fn empty_report(schedule: &Schedule, opts: &Options, checks: &[&dyn StepCheck]) 
     }
 }
 
-/// The violation of a configuration (`which`: initial or final) with
+/// The violation of a configuration (`which`: "initial configuration", …) with
 /// modules not connected to the ground.
 fn disconnected(step: usize, which: &str, loose: Vec<crate::lattice::ModuleId>) -> Violation {
     Violation::new(
         ViolationKind::Disconnected,
         step,
         format!(
-            "the {which} configuration has {} module(s) not connected to the ground",
+            "the {which} has {} module(s) not connected to the ground",
             loose.len()
         ),
     )
@@ -530,15 +589,16 @@ fn disconnected(step: usize, which: &str, loose: Vec<crate::lattice::ModuleId>) 
 fn one_pass(
     world: &mut World,
     schedule: &Schedule,
+    steps: std::ops::Range<usize>,
     inline: &[&dyn StepCheck],
     range: usize,
     report: &mut Report,
     bar: &Reporter,
 ) -> Result<Vec<(usize, World)>, InputError> {
     let mut starts = Vec::new();
-    for k in 0..schedule.steps.len() {
+    for k in steps.clone() {
         let index = k + 1;
-        if range > 0 && k % range == 0 {
+        if range > 0 && (k - steps.start).is_multiple_of(range) {
             starts.push((k, world.clone()));
         }
         let (mut out, plan, clashes) = advance(world, schedule, k, |ctx| {
@@ -577,11 +637,11 @@ fn one_pass(
 }
 
 /// Merges the ranged checks' findings (0-based step, outcome) into the
-/// report, then puts the findings back in step order, each step's own in
-/// check order.
-fn merge(report: &mut Report, outcomes: Vec<(usize, StepOutcome)>) {
+/// report, whose results start at step `from` (0-based), then puts the
+/// findings back in step order, each step's own in check order.
+fn merge(report: &mut Report, from: usize, outcomes: Vec<(usize, StepOutcome)>) {
     for (k, out) in outcomes {
-        let r = &mut report.per_step[k];
+        let r = &mut report.per_step[k - from];
         r.violations += out.violations.len();
         r.warnings += out.warnings.len();
         r.metrics.extend(out.metrics);
@@ -603,7 +663,7 @@ fn final_checks(
     if !loose.is_empty() {
         report
             .violations
-            .push(disconnected(final_step, "final", loose));
+            .push(disconnected(final_step, "final configuration", loose));
     }
     let mut out = StepOutcome::default();
     for c in checks {

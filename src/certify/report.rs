@@ -184,6 +184,29 @@ pub struct StepResult {
     pub metrics: BTreeMap<String, f64>,
 }
 
+/// The steps a certification checked when it was asked for part of a
+/// schedule (`certify --steps FIRST-LAST`), 1-based and inclusive as
+/// steps are numbered everywhere. The steps before `first` were replayed
+/// to reach its configuration, without checks; those after `last` were
+/// not replayed.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepSpan {
+    pub first: usize,
+    pub last: usize,
+}
+
+impl StepSpan {
+    /// Whether step `k` of a schedule of `steps` steps was checked: its
+    /// initial configuration (`k` = 0) with the first step, its final one
+    /// (`steps + 1`) with the last.
+    pub fn holds(&self, k: usize, steps: usize) -> bool {
+        (k == 0 && self.first == 1)
+            || (self.first..=self.last).contains(&k)
+            || (k == steps + 1 && self.last == steps)
+    }
+}
+
 /// The certificate (or its refusal) for one schedule.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Report {
@@ -199,6 +222,10 @@ pub struct Report {
     pub final_modules: usize,
     pub steps: usize,
     pub moves: usize,
+    /// The steps checked, where only part of the schedule was
+    /// (`--steps`); absent when every step was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window: Option<StepSpan>,
     /// Names of the checks that were run.
     pub checks: Vec<String>,
     /// How far above the exact smallest load factor of a step's poses the
@@ -260,9 +287,14 @@ impl Report {
             .iter()
             .any(|c| c.starts_with("mechanics: not run"));
         let lattice_only = !ran("collision") && !ran("mechanics") && !no_model;
+        let (first, last) = self.window.map_or((1, self.steps), |w| (w.first, w.last));
         let covered = match self.stopped_at {
-            Some(k) => format!("steps 1–{k}"),
-            None => format!("steps 1–{} and the final configuration", self.steps),
+            Some(k) if k < first => "no step".to_string(),
+            Some(k) => format!("steps {first}–{k}"),
+            None if last == self.steps => {
+                format!("steps {first}–{last} and the final configuration")
+            }
+            None => format!("steps {first}–{last}"),
         };
         let checked = self
             .checks
@@ -315,9 +347,21 @@ impl Report {
                 ViolationKind::JudgedAtSamples.name()
             ));
         }
+        if first > 1 {
+            not_checked.push(format!(
+                "the initial configuration and steps 1–{}: replayed to reach step {first} (--steps)",
+                first - 1
+            ));
+        }
         if let Some(k) = self.stopped_at {
             not_checked.push(format!(
                 "steps after {k}: the state is undefined from there on"
+            ));
+        } else if last < self.steps {
+            not_checked.push(format!(
+                "steps {}–{} and the final configuration: after the steps asked for (--steps)",
+                last + 1,
+                self.steps
             ));
         }
         (checked, not_checked)
@@ -440,6 +484,7 @@ mod tests {
             final_modules: 5,
             steps: 9,
             moves: 9,
+            window: None,
             checks: vec!["lattice".into()],
             load_factor_tolerance: 0.0,
             certified: violations.is_empty(),

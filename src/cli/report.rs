@@ -71,6 +71,13 @@ pub struct ReportArgs {
     /// in their last digits, never with the thread count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     range_steps: Option<u32>,
+    /// Check only steps FIRST to LAST (numbered as in the report; `FIRST-`
+    /// runs to the end, one number is one step). The steps before FIRST
+    /// are replayed without checks, and the report keeps the schedule's
+    /// step numbers: a minute for a window of a long schedule whose
+    /// every step takes a quarter of an hour.
+    #[arg(long, value_name = "FIRST-LAST", value_parser = certify::StepRequest::parse)]
+    steps: Option<certify::StepRequest>,
 }
 
 impl ReportArgs {
@@ -97,6 +104,7 @@ impl ReportArgs {
                 .then_some(print_range_time),
             load_factor_tolerance: t,
             meta_level: self.meta_level,
+            steps: self.steps,
         })
     }
 }

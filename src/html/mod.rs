@@ -220,12 +220,16 @@ impl Page<'_> {
                 r.per_step.iter().flat_map(|s| s.metrics.keys()).collect();
             names.sort();
             names.dedup();
+            // Indexed by step number (the page reads value i as step i + 1):
+            // a report of part of a schedule (`--steps`) starts later.
+            let last = r.per_step.iter().map(|s| s.step).max().unwrap_or(0);
             for name in names {
-                let values = r
-                    .per_step
-                    .iter()
-                    .map(|s| s.metrics.get(name).copied().filter(|v| v.is_finite()))
-                    .collect();
+                let mut values = vec![None; last];
+                for s in &r.per_step {
+                    if let Some(i) = s.step.checked_sub(1) {
+                        values[i] = s.metrics.get(name).copied().filter(|v| v.is_finite());
+                    }
+                }
                 metrics.push((name.clone(), values));
             }
         }

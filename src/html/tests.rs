@@ -113,6 +113,39 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
     );
 }
 
+/// A report of part of a schedule (`--steps`) is drawn at its steps'
+/// numbers: the page reads the i-th per-step value as step i + 1.
+#[test]
+fn per_step_maxima_sit_at_their_step_numbers_when_a_span_was_checked() {
+    let s = scaffold();
+    let opts = Options {
+        steps: Some(certify::StepRequest::parse("20-30").unwrap()),
+        ..Options::lattice_only()
+    };
+    let mut report = certify::certify(&s, &opts).unwrap();
+    for r in &mut report.per_step {
+        r.metrics.insert("max_utilisation".into(), r.step as f64);
+    }
+    let data = inlined(
+        &Page {
+            title: "span".into(),
+            report: Some(&report),
+            ..Default::default()
+        }
+        .html(),
+    );
+    let values = data["metrics"][0][1].as_array().unwrap();
+    assert_eq!(values.len(), 30);
+    for (i, v) in values.iter().enumerate() {
+        let step = i + 1;
+        if (20..=30).contains(&step) {
+            assert_eq!(v.as_f64(), Some(step as f64), "step {step}");
+        } else {
+            assert!(v.is_null(), "step {step}: {v}");
+        }
+    }
+}
+
 #[test]
 fn the_page_loads_nothing_from_the_network() {
     let s = colliding_walk();

@@ -365,6 +365,40 @@ fn a_range_size_below_one_step_is_refused_and_any_other_gives_the_same_verdicts(
     }
 }
 
+#[test]
+fn steps_outside_the_schedule_or_unreadable_are_refused_and_a_span_keeps_its_numbers() {
+    refused_on_default("--steps", &["0", "5-3", "x", "1-y", "-4", "175", "100-175"]);
+    // The default scenario has 174 steps: a span of them, by their numbers,
+    // with the steps before it and after it named as not checked.
+    let path = scratch("steps-span.json");
+    let o = bin()
+        .args(["run", "--no-progress", "--steps", "101-120", "--json"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("checked: lattice (steps 101–120)"), "{out}");
+    assert!(
+        out.contains("NOT checked: the initial configuration and steps 1–100"),
+        "{out}"
+    );
+    assert!(
+        out.contains("NOT checked: steps 121–174 and the final configuration"),
+        "{out}"
+    );
+    let r: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(r["window"], serde_json::json!({"first": 101, "last": 120}));
+    assert_eq!(r["steps"], 174);
+    let steps: Vec<u64> = r["per_step"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["step"].as_u64().unwrap())
+        .collect();
+    assert_eq!(steps, (101..=120).collect::<Vec<_>>());
+}
+
 /// A cantilever two modules deep from one fixed root, seven long, with a
 /// module swinging on its upper tip: it holds only plastically, at every
 /// pose (one step).

@@ -98,6 +98,98 @@ fn a_window_that_starts_with_a_released_latch_is_refused() {
     assert!(reconfcheck::certify::window(s, 0, 3).is_ok());
 }
 
+/// Certifies steps `span` (`--steps`) with the lattice checks only.
+fn span_report(s: &Schedule, span: &str) -> reconfcheck::certify::Report {
+    let opts = reconfcheck::certify::Options {
+        steps: Some(reconfcheck::certify::StepRequest::parse(span).unwrap()),
+        ..reconfcheck::certify::Options::lattice_only()
+    };
+    reconfcheck::certify::certify(s, &opts).expect("usable input")
+}
+
+/// `--steps` starts from the scene the replay reaches, released latches
+/// included (a window schedule cannot say so and is refused, above).
+#[test]
+fn a_span_of_steps_starts_with_the_latches_its_replay_released() {
+    let mut s = with_a_released_latch();
+    step(
+        &mut s,
+        vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
+    );
+    let r = span_report(&s, "2");
+    assert_eq!(kinds(&r), vec![(MoverDetached, 2)]);
+    let steps: Vec<usize> = r.per_step.iter().map(|p| p.step).collect();
+    assert_eq!(steps, vec![2]);
+    // Latched again before the move: clean, from step 2 on.
+    let mut s = with_a_released_latch();
+    step(
+        &mut s,
+        vec![Event::Attach {
+            module: 100,
+            other: 3,
+        }],
+    );
+    step(
+        &mut s,
+        vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
+    );
+    let r = span_report(&s, "2-");
+    assert!(r.certified, "{}", r.summary());
+}
+
+/// A clash in the steps replayed to reach a span stops there, reported:
+/// the span's steps would start from no configuration.
+#[test]
+fn a_span_after_a_clash_reports_it_and_checks_nothing() {
+    let mut s = fcc_platform();
+    add(&mut s, 100, Cell::new(0, 0, 1));
+    add(&mut s, 101, Cell::new(1, 1, 1));
+    step(
+        &mut s,
+        vec![
+            rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1)),
+            rot(101, 4, Cell::new(1, 1, 1), Cell::new(1, 0, 1)),
+        ],
+    );
+    step(&mut s, Vec::new());
+    let r = span_report(&s, "2");
+    assert!(!r.certified);
+    assert_eq!(kinds(&r), vec![(Occupancy, 1)]);
+    assert_eq!(r.stopped_at, Some(1));
+    assert!(r.per_step.is_empty());
+    assert!(
+        r.summary().contains("checked: lattice (no step)"),
+        "{}",
+        r.summary()
+    );
+}
+
+/// The scene a span starts from must stand on its own, as an initial
+/// configuration must: the unchecked steps before it cannot vouch for it.
+#[test]
+fn a_span_starting_from_a_disconnected_scene_says_so() {
+    let mut s = fcc_platform();
+    add(&mut s, 100, Cell::new(0, 0, 1));
+    add(&mut s, 200, Cell::new(1, 1, 2)); // rides on 100 only
+    step(
+        &mut s,
+        vec![rot(100, 0, Cell::new(0, 0, 1), Cell::new(-1, 0, 1))],
+    );
+    step(&mut s, Vec::new());
+    let r = span_report(&s, "2");
+    let v = r
+        .violations
+        .iter()
+        .find(|v| v.kind == Disconnected)
+        .expect("the start of the span is disconnected");
+    assert_eq!((v.step, v.modules.as_slice()), (1, [200].as_slice()));
+    assert!(
+        v.message.contains("after step 1, where --steps starts"),
+        "{}",
+        v.message
+    );
+}
+
 #[test]
 fn lifting_the_only_support_of_a_module_disconnects_it() {
     let mut s = fcc_platform();

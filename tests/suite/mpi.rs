@@ -92,8 +92,24 @@ fn two_processes_certify_to_the_same_report_as_one() {
 
 #[cfg(feature = "mpi")]
 #[test]
+fn two_processes_certify_a_span_of_steps_to_the_same_report_as_one() {
+    // Steps 60-174 of the default scenario: 8 ranges from step 60.
+    let run = |out: &PathBuf| {
+        vec![
+            "run".to_string(),
+            "--no-progress".into(),
+            "--steps=60-".into(),
+            format!("--json={}", out.display()),
+        ]
+    };
+    let files = (scratch("span-one.json"), scratch("span-two.json"));
+    alone_and_on(2, run, files, 0, "\"window\"");
+}
+
+#[cfg(feature = "mpi")]
+#[test]
 fn three_processes_certify_an_overloaded_schedule_to_the_same_report_as_one() {
-    // The 2-pyramid at b = 9 is overloaded from step 84 on: its violations
+    // The 2-pyramid at b = 9 is overloaded at steps 36-39 and 73-77: its violations
     // travel between ranks (their encoding skips default fields), and its
     // 8 ranges are handed out one by one by rank 0's dispatcher.
     let scenario = scratch("p2b9.toml");

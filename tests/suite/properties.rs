@@ -93,6 +93,48 @@ proptest! {
         prop_assert_eq!(got, expected);
     }
 
+    /// Any span of steps (`--steps`) of a walk with a rider finds exactly the
+    /// whole run's violations inside it, and a disconnected rider at its
+    /// start where no neighbour holds it there (computed here
+    /// independently, as for the final configuration).
+    #[test]
+    fn a_span_of_steps_finds_the_whole_runs_violations_inside_it(
+        p in params(),
+        pick in any::<prop::sample::Index>(),
+        a in any::<prop::sample::Index>(),
+        b in any::<prop::sample::Index>(),
+    ) {
+        let mut s = walk(&p, &|_, _, _| true);
+        let walkers: Vec<&ModuleSpec> = s.modules.iter().filter(|m| !m.fixed).collect();
+        let rider_cell = FccLattice.neighbour(walkers[pick.index(walkers.len())].cell, 4);
+        s.modules.push(ModuleSpec { id: 10_000, cell: rider_cell, fixed: false });
+        let n = s.steps.len();
+        let (first, last) = {
+            let (x, y) = (a.index(n) + 1, b.index(n) + 1);
+            (x.min(y), x.max(y))
+        };
+        let whole = lattice_report(&s);
+        let opts = reconfcheck::certify::Options {
+            steps: Some(reconfcheck::certify::StepRequest { first, last: Some(last) }),
+            ..reconfcheck::certify::Options::lattice_only()
+        };
+        let span = reconfcheck::certify::certify(&s, &opts).unwrap();
+        let key = |v: &reconfcheck::certify::Violation| (v.kind, v.step, v.modules.clone());
+        let mut expected: Vec<_> = whole.violations.iter()
+            .filter(|v| (first..=last).contains(&v.step) || (v.step == n + 1 && last == n))
+            .map(key)
+            .collect();
+        let cells = cells_per_step(&s);
+        let held = cells[first - 1].iter()
+            .any(|(id, c)| *id != 10_000 && FccLattice.are_neighbours(*c, rider_cell));
+        if first > 1 && !held {
+            expected.insert(0, (ViolationKind::Disconnected, first - 1, vec![10_000]));
+        }
+        prop_assert_eq!(span.violations.iter().map(key).collect::<Vec<_>>(), expected);
+        prop_assert_eq!(span.per_step.len(), last - first + 1);
+        prop_assert_eq!(span.certified, span.violations.is_empty());
+    }
+
     /// Releasing the latch between a mover and its pivot one step before the
     /// move is caught as a detached mover at that move.
     #[test]
