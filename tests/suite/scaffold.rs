@@ -273,6 +273,53 @@ fn the_plot_command_writes_a_png_of_a_scenario() {
     assert_eq!(&png[1..4], b"PNG");
 }
 
+/// An upward branch with nothing under it, at a border, holds up its tile
+/// for its first modules only; the whole branch early (as before) is the
+/// fallback where a module then finds no route: the 2-cube with e = b = 8,
+/// whose sixth LZ module of tile (8, 8, 8) does. Both certify clean.
+#[test]
+fn border_branches_hold_up_their_tile_for_their_first_modules_only() {
+    use reconfcheck::algorithms::scaffold::feed::Feed;
+    use reconfcheck::algorithms::scaffold::paper::Protocol;
+    use reconfcheck::algorithms::scaffold::polytree::BorderBranches;
+    use reconfcheck::algorithms::scaffold::{build_scaffold, motion_rules, schedule_with_border};
+    let cylinder = shape("authors/cylinder-4.xml");
+    let sc = build_scaffold(&cylinder, 6).unwrap();
+    let rules = motion_rules(Protocol::Safe).unwrap();
+    let plan = |border| schedule_with_border(&sc, rules, Protocol::Safe, Feed::JustInTime, border);
+    let (first, whole) = (
+        plan(BorderBranches::FirstModules).unwrap(),
+        plan(BorderBranches::Whole).unwrap(),
+    );
+    // 471 against 518 steps when measured.
+    assert!(
+        first.steps.len() * 100 < whole.steps.len() * 95,
+        "{} {}",
+        first.steps.len(),
+        whole.steps.len()
+    );
+    let by_default = scaffold_schedule(&cylinder, 6).unwrap();
+    assert_eq!(by_default.steps, first.steps);
+    assert_eq!(by_default.meta["border_branches"], "first-modules");
+    for s in [&first, &whole] {
+        let r = certify(s, &Options::default()).unwrap();
+        assert!(r.certified && r.warnings.is_empty(), "{}", r.summary());
+    }
+    let cube = ShapeSpec::Cube { h: 2, e: 8 };
+    let sc = build_scaffold(&cube, 8).unwrap();
+    let e = schedule_with_border(
+        &sc,
+        rules,
+        Protocol::Safe,
+        Feed::JustInTime,
+        BorderBranches::FirstModules,
+    )
+    .unwrap_err();
+    assert!(e.message.contains("no sequence of rotations"), "{e}");
+    let s = scaffold_schedule(&cube, 8).unwrap();
+    assert_eq!(s.meta["border_branches"], "whole");
+}
+
 /// Two movers of one step used to sweep through the same empty cell (each
 /// legal against the structure alone): pyramid h = 2 at b = 4, 8, 9 and
 /// the 2-cube at b = 8 collided at their step 35 / 73 / 83 / 73. The

@@ -182,12 +182,35 @@ pub fn scaffold_schedule_fed(
     Ok(sched)
 }
 
-/// Plans every module of a scaffold and writes the schedule.
+/// Plans every module of a scaffold and writes the schedule: with the
+/// first modules of each unsupported border branch early, or, where some
+/// module then finds no route, with the whole branch early (see
+/// [`polytree::BorderBranches`]; the schedule's `meta.border_branches`
+/// says which).
 pub fn schedule_for(
     s: &Scaffold,
     rules: &dyn MotionRules,
     protocol: Protocol,
     feed: Feed,
+) -> Result<Schedule, InputError> {
+    schedule_with_border(
+        s,
+        rules,
+        protocol,
+        feed,
+        polytree::BorderBranches::FirstModules,
+    )
+    .or_else(|_| schedule_with_border(s, rules, protocol, feed, polytree::BorderBranches::Whole))
+}
+
+/// [`schedule_for`] with as much of each border branch early as `border`
+/// says, and no fallback.
+pub fn schedule_with_border(
+    s: &Scaffold,
+    rules: &dyn MotionRules,
+    protocol: Protocol,
+    feed: Feed,
+    border: polytree::BorderBranches,
 ) -> Result<Schedule, InputError> {
     let tree = polytree::Polytree::build_with(
         s,
@@ -195,6 +218,7 @@ pub fn schedule_for(
             Protocol::Safe => polytree::Supports::OneAfterAnother,
             Protocol::Paper => polytree::Supports::Together,
         },
+        border,
     );
     let n = s.components.len();
     let mut succ = vec![Vec::new(); n];
@@ -313,6 +337,9 @@ pub fn schedule_for(
     sched.meta.insert("b".into(), s.b.into());
     sched.meta.insert("protocol".into(), protocol.name().into());
     sched.meta.insert("feed".into(), feed.name().into());
+    sched
+        .meta
+        .insert("border_branches".into(), border.name().into());
     if let Feed::Eager { window } = feed {
         sched.meta.insert("eager_window".into(), window.into());
     }
