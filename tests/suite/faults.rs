@@ -23,8 +23,8 @@ fn a_clean_walk_certifies() {
     assert_eq!(r.moves, 2);
 }
 
-#[test]
-fn two_movers_ending_in_one_cell_are_an_occupancy_violation() {
+/// Modules 100 and 101 both rotate into cell (1, 0, 1) at step 1.
+fn two_movers_into_one_cell() -> Schedule {
     let mut s = fcc_platform();
     add(&mut s, 100, Cell::new(0, 0, 1));
     add(&mut s, 101, Cell::new(1, 1, 1));
@@ -35,6 +35,12 @@ fn two_movers_ending_in_one_cell_are_an_occupancy_violation() {
             rot(101, 4, Cell::new(1, 1, 1), Cell::new(1, 0, 1)),
         ],
     );
+    s
+}
+
+#[test]
+fn two_movers_ending_in_one_cell_are_an_occupancy_violation() {
+    let s = two_movers_into_one_cell();
     let r = lattice_report(&s);
     assert!(!r.certified);
     assert_eq!(kinds(&r), vec![(Occupancy, 1)]);
@@ -69,10 +75,8 @@ fn a_mover_whose_latch_to_the_pivot_is_released_is_detached() {
     assert_eq!(r.violations[0].modules, vec![100, 3]);
 }
 
-/// A window (`certify::window`) cannot start where a latch is released:
-/// a schedule's initial configuration latches every touching pair.
-#[test]
-fn a_window_that_starts_with_a_released_latch_is_refused() {
+/// [`with_a_released_latch`], latched again at step 2 and moved at 3.
+fn relatched_then_moved() -> Schedule {
     let mut s = with_a_released_latch();
     step(
         &mut s,
@@ -85,6 +89,14 @@ fn a_window_that_starts_with_a_released_latch_is_refused() {
         &mut s,
         vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
     );
+    s
+}
+
+/// A window (`certify::window`) cannot start where a latch is released:
+/// a schedule's initial configuration latches every touching pair.
+#[test]
+fn a_window_that_starts_with_a_released_latch_is_refused() {
+    let s = relatched_then_moved();
     let e = reconfcheck::certify::window(s.clone(), 1, 2)
         .unwrap_err()
         .to_string();
@@ -121,19 +133,7 @@ fn a_span_of_steps_starts_with_the_latches_its_replay_released() {
     let steps: Vec<usize> = r.per_step.iter().map(|p| p.step).collect();
     assert_eq!(steps, vec![2]);
     // Latched again before the move: clean, from step 2 on.
-    let mut s = with_a_released_latch();
-    step(
-        &mut s,
-        vec![Event::Attach {
-            module: 100,
-            other: 3,
-        }],
-    );
-    step(
-        &mut s,
-        vec![rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1))],
-    );
-    let r = span_report(&s, "2-");
+    let r = span_report(&relatched_then_moved(), "2-");
     assert!(r.certified, "{}", r.summary());
 }
 
@@ -141,16 +141,7 @@ fn a_span_of_steps_starts_with_the_latches_its_replay_released() {
 /// the span's steps would start from no configuration.
 #[test]
 fn a_span_after_a_clash_reports_it_and_checks_nothing() {
-    let mut s = fcc_platform();
-    add(&mut s, 100, Cell::new(0, 0, 1));
-    add(&mut s, 101, Cell::new(1, 1, 1));
-    step(
-        &mut s,
-        vec![
-            rot(100, 3, Cell::new(0, 0, 1), Cell::new(1, 0, 1)),
-            rot(101, 4, Cell::new(1, 1, 1), Cell::new(1, 0, 1)),
-        ],
-    );
+    let mut s = two_movers_into_one_cell();
     step(&mut s, Vec::new());
     let r = span_report(&s, "2");
     assert!(!r.certified);
@@ -168,13 +159,7 @@ fn a_span_after_a_clash_reports_it_and_checks_nothing() {
 /// configuration must: the unchecked steps before it cannot vouch for it.
 #[test]
 fn a_span_starting_from_a_disconnected_scene_says_so() {
-    let mut s = fcc_platform();
-    add(&mut s, 100, Cell::new(0, 0, 1));
-    add(&mut s, 200, Cell::new(1, 1, 2)); // rides on 100 only
-    step(
-        &mut s,
-        vec![rot(100, 0, Cell::new(0, 0, 1), Cell::new(-1, 0, 1))],
-    );
+    let mut s = a_riders_only_support_lifted();
     step(&mut s, Vec::new());
     let r = span_report(&s, "2");
     let v = r
@@ -190,8 +175,8 @@ fn a_span_starting_from_a_disconnected_scene_says_so() {
     );
 }
 
-#[test]
-fn lifting_the_only_support_of_a_module_disconnects_it() {
+/// Module 200 rides on 100 only; 100 rotates away at step 1.
+fn a_riders_only_support_lifted() -> Schedule {
     let mut s = fcc_platform();
     add(&mut s, 100, Cell::new(0, 0, 1));
     add(&mut s, 200, Cell::new(1, 1, 2)); // rides on 100 only
@@ -199,6 +184,12 @@ fn lifting_the_only_support_of_a_module_disconnects_it() {
         &mut s,
         vec![rot(100, 0, Cell::new(0, 0, 1), Cell::new(-1, 0, 1))],
     );
+    s
+}
+
+#[test]
+fn lifting_the_only_support_of_a_module_disconnects_it() {
+    let s = a_riders_only_support_lifted();
     let r = lattice_report(&s);
     let k = kinds(&r);
     assert!(k.contains(&(Disconnected, 1)), "{k:?}");
