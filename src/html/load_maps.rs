@@ -112,8 +112,9 @@ fn spread(steps: &[usize], k: usize) -> Vec<usize> {
 /// `steps + 1`), then further steps evenly spread while an upper estimate
 /// of their connectors fits `budget` (the most connectors per body seen so
 /// far, times the most modules the run has). Maps of a step whose
-/// structure has no connector are left out. Two replays of the schedule,
-/// each solving only its chosen steps.
+/// structure has no connector are left out; so are the steps a report of
+/// part of the schedule (`--steps`) did not check. Two replays of the
+/// schedule, each solving only its chosen steps.
 pub fn load_maps(
     schedule: &Schedule,
     model: &Model,
@@ -121,8 +122,13 @@ pub fn load_maps(
     budget: usize,
 ) -> Result<Vec<LoadMap>, InputError> {
     let last = schedule.steps.len() + 1;
+    let checked = |k: usize| {
+        report
+            .window
+            .is_none_or(|w| w.holds(k, schedule.steps.len()))
+    };
     let mut first = priority_steps(report, FIRST);
-    if !first.iter().any(|s| s.0 == last) {
+    if checked(last) && !first.iter().any(|s| s.0 == last) {
         first.push((last, Why::Final));
     }
     let wanted: Vec<usize> = first.iter().map(|s| s.0).collect();
@@ -138,7 +144,9 @@ pub fn load_maps(
     let most_modules = report.modules.max(report.final_modules).max(1);
     let per_map = (per_body * most_modules as f64).ceil().max(1.0) as usize;
     let room = budget.saturating_sub(used) / per_map;
-    let rest: Vec<usize> = (1..=last).filter(|k| !wanted.contains(k)).collect();
+    let rest: Vec<usize> = (1..=last)
+        .filter(|&k| checked(k) && !wanted.contains(&k))
+        .collect();
     let extra = spread(&rest, room);
     if !extra.is_empty() {
         let mut more: Vec<LoadMap> = certify::load_maps_at(schedule, model, &extra)?

@@ -113,6 +113,25 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
     );
 }
 
+/// A page of part of a schedule (`--steps`) maps the loads of the steps
+/// that were checked, every one of them when the budget allows, and no
+/// other (not the final configuration, which was not reached).
+#[test]
+fn a_span_of_steps_has_load_maps_of_its_steps_only() {
+    let s = scaffold();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let model = crate::mechanics::Model::load(&path).unwrap();
+    let opts = Options {
+        model: Some(path),
+        steps: Some(certify::StepRequest::parse("30-40").unwrap()),
+        ..Options::default()
+    };
+    let report = certify::certify(&s, &opts).unwrap();
+    let maps = load_maps(&s, &model, &report, usize::MAX).unwrap();
+    let steps: Vec<usize> = maps.iter().map(|m| m.step).collect();
+    assert_eq!(steps, (30..=40).collect::<Vec<_>>());
+}
+
 /// A report of part of a schedule (`--steps`) is drawn at its steps'
 /// numbers: the page reads the i-th per-step value as step i + 1.
 #[test]

@@ -345,7 +345,7 @@
       label.textContent = k === 0 ? `initial (0 / ${steps})` : k === last ? `final (${steps} / ${steps})` : `step ${k} / ${steps}`;
       info.replaceChildren(...[el('h3', {}, label.textContent),
         showLoad ? el('p', {}, `load map: max utilisation ${fmt(lm.max_utilisation)} over ${lm.connectors} connectors`)
-          : D.load_maps.length && !lm ? el('p', { class: 'hint' }, `no load map at this step: ${D.load_maps.length} of ${D.load_maps_of} steps have one (the page's size budget)`) : null,
+          : D.load_maps.length && !lm ? el('p', { class: 'hint' }, `no load map at this step: ${D.load_maps.length} of ${D.load_maps_of} steps have one (the page's size budget; steps outside a --steps span have none)`) : null,
         found.length ? el('ul', {}, ...found.slice(0, 50).map(v => el('li', { class: v.severity }, `${v.severity} ${v.kind}: ${v.message}`))) : el('p', {}, 'no findings at this step'),
         found.length > 50 ? el('p', {}, `… ${found.length - 50} more`) : null].filter(x => x));
       state.step = k; state.highlighted = highlighted; state.markers = markers.children.length; state.loadmap = showLoad ? lm.connectors : 0;
