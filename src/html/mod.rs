@@ -82,6 +82,9 @@ pub struct Summary {
     pub checked: Vec<String>,
     pub not_checked: Vec<String>,
     pub stopped_at: Option<usize>,
+    /// The steps checked, where only part of the schedule was (`--steps`):
+    /// the replay opens at the first.
+    pub window: Option<crate::certify::StepSpan>,
 }
 
 /// One violation or warning, placed in the scene.
@@ -178,6 +181,7 @@ impl Page<'_> {
                 checked,
                 not_checked,
                 stopped_at: r.stopped_at,
+                window: r.window,
             }
         });
         let (violations, warnings, warnings_total) = match self.report {

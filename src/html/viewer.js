@@ -424,7 +424,7 @@
   }
   let readyMs = null, playMs = null;
   if (D.replay && !window.THREE) console.error('three.js did not load');
-  if (viewer) viewer.goTo(hash.has('step') ? +hash.get('step') : 0);
+  if (viewer) viewer.goTo(hash.has('step') ? +hash.get('step') : (D.summary && D.summary.window ? D.summary.window.first : 0));
   readyMs = (performance.now()).toFixed(0);
   report();
   // `#play=N`: step forward N times as the play button does, each step

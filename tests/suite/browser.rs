@@ -171,6 +171,26 @@ fn the_report_page_loads_with_no_console_errors() {
     assert!(console_errors(&console).is_empty(), "{console}");
 }
 
+/// A page of part of a schedule (`--steps 3-`) opens at its first step;
+/// a step in the URL still wins.
+#[test]
+fn a_span_page_opens_at_its_first_checked_step() {
+    let browser = browser_or_skip!();
+    let page = common::scratch("browser", "span.html");
+    let o = common::bin()
+        .arg("certify")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/walk-fcc.json"))
+        .args(["--no-progress", "--lattice-only", "--steps", "3-", "--html"])
+        .arg(&page)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let (status, console) = status_with(&browser, &page, "");
+    assert_eq!(field(&status, "step"), "3", "{status}\n{console}");
+    let (status, _) = status_at(&browser, &page, 1);
+    assert_eq!(field(&status, "step"), "1", "{status}");
+}
+
 #[test]
 fn the_step_slider_changes_the_scene() {
     let browser = browser_or_skip!();
