@@ -133,8 +133,8 @@ impl Polytree {
             // its first modules (`border`) go in right after the tile's first
             // modules, before anything else of the tile hems them in; the
             // rest follow on them without holding up the tile. (The
-            // supports of the paper protocol, which go in together, do not
-            // wait for them.)
+            // supports of the paper protocol, which go in together, wait
+            // for them only when the whole branch is early, as before.)
             let unsupported: Vec<(Dir, u32)> = t
                 .branches
                 .iter()
@@ -143,7 +143,7 @@ impl Polytree {
                     d.is_upward() && t.layer > 0 && !t.ingoing_up.contains(&d.mirror())
                 })
                 .collect();
-            let before_supports = early.clone();
+            let mut before_supports = early.clone();
             let mut lone_prev: Option<usize> = None;
             for &(d, len) in &unsupported {
                 for m in 1..=len as i32 {
@@ -163,6 +163,9 @@ impl Polytree {
                 let held = idx(r.offset(d.step().scale(early_len as i32))).expect("branch module");
                 early.push(held);
                 lone_prev = Some(held);
+            }
+            if border == BorderBranches::Whole {
+                before_supports = early.clone();
             }
             for &u in &t.ingoing_up {
                 let si = idx(r.offset(u.mirror().support_offset())).expect("support exists");
