@@ -100,7 +100,7 @@ pub fn compare(current: &Report, baseline: &Report, tolerance: f64) -> Compariso
     let mut out = Comparison::default();
     // Where the current report checked part of the schedule (`--steps`),
     // the baseline's findings elsewhere are neither fixed nor compared.
-    let within = |step: usize| current.window.is_none_or(|w| w.holds(step, current.steps));
+    let within = |step: usize| current.in_window(step);
     let baseline_violations: Vec<&Violation> = baseline
         .violations
         .iter()

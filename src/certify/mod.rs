@@ -380,15 +380,7 @@ pub fn certify_on(
     let bar = &opts.progress;
     bar.start("certifying", (passes * (to - from)) as u64);
 
-    if from == 0 {
-        // The initial configuration must stand on its own.
-        let loose = world.check_anchored();
-        if !loose.is_empty() {
-            report
-                .violations
-                .push(disconnected(0, "initial configuration", loose));
-        }
-    } else if !replay_to(&mut world, schedule, from, &mut report)? {
+    if !replay_to(&mut world, schedule, from, &mut report)? {
         bar.finish();
         return Ok(report);
     }
@@ -518,29 +510,48 @@ impl RangeRunner for Threads {
     }
 }
 
-/// Replays the first `steps` steps without checks (`--steps` starts
-/// later). A step that leaves two modules in one cell stops the replay,
-/// its clash reported. Then the configuration reached must stand on its
-/// own, as the initial one must: unchecked steps cannot vouch for it (nor
-/// be taken to keep it anchored, which the connectivity search's shortcut
-/// relies on). Returns whether the replay reached the first step to check.
+/// Replays the first `steps` steps (0-based) without checks, up to the
+/// first that leaves two modules in one cell: that step and its clashes,
+/// if one does. The lattice replay the window schedule and `--steps`
+/// share.
+pub(crate) fn replay_unchecked(
+    world: &mut World,
+    schedule: &Schedule,
+    steps: usize,
+) -> Result<Option<(usize, Vec<Violation>)>, InputError> {
+    for k in 0..steps {
+        let (_, _, clashes) = advance(world, schedule, k, |_| ())?;
+        if !clashes.is_empty() {
+            return Ok(Some((k, clashes)));
+        }
+    }
+    Ok(None)
+}
+
+/// Brings `world` to the first step to check, `steps` (0-based; more than
+/// 0 when `--steps` starts later), replaying the steps before it without
+/// checks. A clash on the way stops the replay, reported. The
+/// configuration reached must then stand on its own: the initial one, or
+/// the one after unchecked steps, which cannot vouch for it (nor be taken
+/// to keep it anchored, which the connectivity search's shortcut relies
+/// on). Returns whether the replay reached the first step to check.
 fn replay_to(
     world: &mut World,
     schedule: &Schedule,
     steps: usize,
     report: &mut Report,
 ) -> Result<bool, InputError> {
-    for k in 0..steps {
-        let (_, _, clashes) = advance(world, schedule, k, |_| ())?;
-        if !clashes.is_empty() {
-            report.violations.extend(clashes);
-            report.stopped_at = Some(k + 1);
-            return Ok(false);
-        }
+    if let Some((k, clashes)) = replay_unchecked(world, schedule, steps)? {
+        report.violations.extend(clashes);
+        report.stopped_at = Some(k + 1);
+        return Ok(false);
     }
     let loose = world.check_anchored();
     if !loose.is_empty() {
-        let which = format!("configuration after step {steps}, where --steps starts,");
+        let which = match steps {
+            0 => "initial configuration".to_string(),
+            _ => format!("configuration after step {steps}, where --steps starts,"),
+        };
         report.violations.push(disconnected(steps, &which, loose));
     }
     Ok(true)

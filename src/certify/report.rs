@@ -254,6 +254,13 @@ impl Report {
         serde_json::to_string_pretty(self).expect("reports serialise")
     }
 
+    /// Whether step `k` (0: the initial configuration, `steps + 1`: the
+    /// final one) lies in the steps this report was asked to check: every
+    /// step unless `--steps` narrowed them (a stop is not considered).
+    pub fn in_window(&self, k: usize) -> bool {
+        self.window.is_none_or(|w| w.holds(k, self.steps))
+    }
+
     /// Counts of violations by kind.
     pub fn violation_counts(&self) -> BTreeMap<ViolationKind, usize> {
         let mut m = BTreeMap::new();

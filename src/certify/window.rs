@@ -72,7 +72,7 @@ impl StepRequest {
 
 /// Steps `start + 1 ..= start + count` of `s`, from the configuration its
 /// replay reaches after step `start` (the lattice replay alone, by
-/// [`super::advance`]: no check runs). Takes the schedule, whose steps
+/// [`super::replay_unchecked`]: no check runs). Takes the schedule, whose steps
 /// the window keeps a slice of (the sandcastle's are 46 MB). Refused where the window is empty or runs past the end, where
 /// a step before it cannot be replayed, and where pairs of modules are
 /// detached at its start (the schedule format has no field for that:
@@ -85,15 +85,12 @@ pub fn window(mut s: Schedule, start: usize, count: usize) -> Result<Schedule, I
         )));
     }
     let mut world = World::initial(&s)?;
-    for k in 0..start {
-        let (_, _, clashes) = super::advance(&mut world, &s, k, |_| ())?;
-        if let Some(v) = clashes.first() {
-            return Err(InputError::new(format!(
-                "step {}: {}; a window after it would start from no configuration",
-                k + 1,
-                v.message
-            )));
-        }
+    if let Some((k, clashes)) = super::replay_unchecked(&mut world, &s, start)? {
+        return Err(InputError::new(format!(
+            "step {}: {}; a window after it would start from no configuration",
+            k + 1,
+            clashes[0].message
+        )));
     }
     if world.detached_pairs() > 0 {
         return Err(InputError::new(format!(

@@ -122,11 +122,7 @@ pub fn load_maps(
     budget: usize,
 ) -> Result<Vec<LoadMap>, InputError> {
     let last = schedule.steps.len() + 1;
-    let checked = |k: usize| {
-        report
-            .window
-            .is_none_or(|w| w.holds(k, schedule.steps.len()))
-    };
+    let checked = |k: usize| report.in_window(k);
     let mut first = priority_steps(report, FIRST);
     if checked(last) && !first.iter().any(|s| s.0 == last) {
         first.push((last, Why::Final));
