@@ -453,6 +453,10 @@ fn scenario_bases() -> Vec<(&'static str, &'static str)> {
             "shape = \"pyramid\"\nh = 2\nb = 4\nfeed = \"eager\"\neager_window = 3",
         ),
         (
+            "scaffold",
+            "shape = \"pyramid\"\nh = 2\nb = 4\nflow = \"continuous\"",
+        ),
+        (
             "active-subtraction",
             "mode = \"pas\"\nshape = \"../models/shapes2d/u-shape.txt\"",
         ),

@@ -279,14 +279,23 @@ fn the_plot_command_writes_a_png_of_a_scenario() {
 /// whose sixth LZ module of tile (8, 8, 8) does. Both certify clean.
 #[test]
 fn border_branches_hold_up_their_tile_for_their_first_modules_only() {
-    use reconfcheck::algorithms::scaffold::feed::Feed;
     use reconfcheck::algorithms::scaffold::paper::Protocol;
     use reconfcheck::algorithms::scaffold::polytree::BorderBranches;
     use reconfcheck::algorithms::scaffold::{build_scaffold, motion_rules, schedule_with_border};
+    use reconfcheck::algorithms::scaffold::{feed::Feed, flow::Flow};
     let cylinder = shape("authors/cylinder-4.xml");
     let sc = build_scaffold(&cylinder, 6).unwrap();
     let rules = motion_rules(Protocol::Safe).unwrap();
-    let plan = |border| schedule_with_border(&sc, rules, Protocol::Safe, Feed::JustInTime, border);
+    let plan = |border| {
+        schedule_with_border(
+            &sc,
+            rules,
+            Protocol::Safe,
+            Feed::JustInTime,
+            Flow::NoSurplus,
+            border,
+        )
+    };
     let (first, whole) = (
         plan(BorderBranches::FirstModules).unwrap(),
         plan(BorderBranches::Whole).unwrap(),
@@ -312,6 +321,7 @@ fn border_branches_hold_up_their_tile_for_their_first_modules_only() {
         rules,
         Protocol::Safe,
         Feed::JustInTime,
+        Flow::NoSurplus,
         BorderBranches::FirstModules,
     )
     .unwrap_err();
@@ -374,11 +384,13 @@ fn dense_b4_cubes_are_refused_up_front_naming_the_parameters() {
 /// exact catom body forbids (a study, release build:
 /// `SHAPES=pyramid2,pyramid3,cube-d5 cargo test --release --test suite
 /// scaffold::protocol_study -- --ignored --nocapture`; shape names are `pyramidH`,
-/// or a file stem under models/shapes).
+/// or a file stem under models/shapes; `FEED=eager`, `FLOW=continuous`).
 #[test]
 #[ignore]
 fn protocol_study() {
-    use reconfcheck::algorithms::scaffold::{feed::Feed, paper::Protocol, scaffold_schedule_fed};
+    use reconfcheck::algorithms::scaffold::{
+        feed::Feed, flow::Flow, paper::Protocol, scaffold_schedule_flowing,
+    };
     let names = std::env::var("SHAPES").unwrap_or_else(|_| "pyramid2,pyramid3".into());
     for name in names.split(',') {
         let spec = match name.strip_prefix("pyramid") {
@@ -391,10 +403,14 @@ fn protocol_study() {
             Ok(f) => Feed::parse(&f).expect("FEED is just-in-time or eager"),
             Err(_) => Feed::JustInTime,
         };
-        let mut line = format!("{name} ({}):", feed.name());
+        let flow = match std::env::var("FLOW") {
+            Ok(f) => Flow::parse(&f).expect("FLOW is no-surplus or continuous"),
+            Err(_) => Flow::NoSurplus,
+        };
+        let mut line = format!("{name} ({}, {}):", feed.name(), flow.name());
         for protocol in [Protocol::Safe, Protocol::Paper] {
             let t = std::time::Instant::now();
-            let s = scaffold_schedule_fed(&spec, 6, protocol, feed).unwrap();
+            let s = scaffold_schedule_flowing(&spec, 6, protocol, feed, flow).unwrap();
             let gen_s = t.elapsed().as_secs_f64();
             line += &format!(
                 " {} {} steps ({} modules, {gen_s:.1} s)",
@@ -402,6 +418,15 @@ fn protocol_study() {
                 s.steps.len(),
                 s.meta["scaffold_modules"]
             );
+            if flow == Flow::Continuous {
+                line += &format!(
+                    " [scaffold complete at {}, surplus {} (unreached {}, paper's formula {})]",
+                    s.meta["scaffold_complete_step"],
+                    s.meta["surplus_modules"],
+                    s.meta["surplus_unreached"],
+                    s.meta["paper_surplus"]
+                );
+            }
             if std::env::var("NOCERT").is_err() {
                 let r = certify(&s, &Options::default()).unwrap();
                 // A collision with a module that itself moves in that step
@@ -428,9 +453,14 @@ fn protocol_study() {
 }
 
 #[test]
-fn an_unknown_protocol_or_feed_is_refused_naming_the_scenario_and_the_parameter() {
+fn an_unknown_protocol_feed_or_flow_is_refused_naming_the_scenario_and_the_parameter() {
     let dir = common::scratch_dir("scaffold-protocol");
-    for (param, value) in [("protocol", "lights"), ("feed", "flood"), ("feed", "")] {
+    for (param, value) in [
+        ("protocol", "lights"),
+        ("feed", "flood"),
+        ("feed", ""),
+        ("flow", "flood"),
+    ] {
         let p = dir.join(format!("bad-{param}.toml"));
         std::fs::write(
             &p,
@@ -638,4 +668,132 @@ fn the_authors_plated_sandcastle_and_domed_cube_are_accepted_and_the_bowled_cube
     // Their bowled cube stays outside the class: its rim overhangs.
     let e = build_scaffold(&shape("bowled-cube.csg"), 6).unwrap_err();
     assert!(e.message.contains("overhangs"), "{}", e.message);
+}
+
+/// Where every module of `s` ends (sandbox, scaffold and surplus).
+fn final_cells(
+    s: &reconfcheck::schedule::Schedule,
+) -> std::collections::BTreeMap<u32, reconfcheck::lattice::Cell> {
+    use reconfcheck::schedule::Event;
+    let mut at: std::collections::BTreeMap<u32, _> =
+        s.modules.iter().map(|m| (m.id, m.cell)).collect();
+    for e in s.steps.iter().flat_map(|st| &st.events) {
+        match e {
+            Event::Enter { module, cell } => {
+                at.insert(*module, *cell);
+            }
+            Event::Rotate { module, to, .. } => {
+                at.insert(*module, *to);
+            }
+            other => panic!("a scaffold schedule has no {other:?}"),
+        }
+    }
+    at
+}
+
+/// Continuous Flow (seed 000 §4.3.1, `flow = "continuous"`): the surplus
+/// is planned after the scaffold, so the scaffold's modules make the
+/// No-Surplus moves step for step; the surplus parks on the chains of
+/// whole upward branches, two per branch at b = 6 (an h-pyramid has
+/// 4·Σ k² whole upward branches, k = 1 … h − 1), none in a scaffold cell
+/// or touching another; the safe schedule certifies clean with the exact
+/// body and the shipped model's mechanics.
+#[test]
+fn continuous_flow_parks_surplus_on_the_branches_without_changing_the_scaffolds_moves() {
+    use reconfcheck::algorithms::scaffold::{
+        feed::Feed, flow::Flow, paper::Protocol, scaffold_schedule_flowing,
+    };
+    use reconfcheck::lattice::{FccLattice, Lattice};
+    for h in [2u32, 3] {
+        let spec = ShapeSpec::Pyramid { h };
+        let plan =
+            |flow| scaffold_schedule_flowing(&spec, 6, Protocol::Safe, Feed::JustInTime, flow);
+        let (plain, flowing) = (
+            plan(Flow::NoSurplus).unwrap(),
+            plan(Flow::Continuous).unwrap(),
+        );
+        // Ids are the sandbox's, then the scaffold's, then the surplus's.
+        let first_surplus = plain.final_module_count() as u32;
+        assert!(flowing.steps.len() >= plain.steps.len());
+        for (k, st) in flowing.steps.iter().enumerate() {
+            let scaffold: Vec<_> = st
+                .events
+                .iter()
+                .filter(|e| e.module() < first_surplus)
+                .cloned()
+                .collect();
+            let expected = plain.steps.get(k).map_or(Vec::new(), |p| p.events.clone());
+            assert_eq!(scaffold, expected, "h = {h}, step {}", k + 1);
+        }
+        let whole: usize = (1..h as usize).map(|k| 4 * k * k).sum();
+        let ends = final_cells(&flowing);
+        let surplus: Vec<_> = ends.range(first_surplus..).map(|(_, &c)| c).collect();
+        assert_eq!(surplus.len(), 2 * whole, "h = {h}");
+        assert_eq!(flowing.meta["surplus_modules"], 2 * whole);
+        assert_eq!(flowing.meta["surplus_unreached"], 0);
+        assert_eq!(flowing.meta["scaffold_complete_step"], plain.steps.len());
+        let scaffold: std::collections::BTreeSet<_> = final_cells(&plain).into_values().collect();
+        let l = FccLattice;
+        for &c in &surplus {
+            assert!(
+                !scaffold.contains(&c),
+                "h = {h}: surplus in scaffold cell {c}"
+            );
+            assert!(
+                (0..12).any(|k| scaffold.contains(&l.neighbour(c, k))),
+                "h = {h}: surplus at {c} hangs on nothing of the scaffold"
+            );
+            assert!(
+                (0..12).all(|k| !surplus.contains(&l.neighbour(c, k))),
+                "h = {h}: surplus at {c} touches another"
+            );
+        }
+    }
+    let s = scaffold_schedule_flowing(
+        &ShapeSpec::Pyramid { h: 2 },
+        6,
+        Protocol::Safe,
+        Feed::JustInTime,
+        Flow::Continuous,
+    )
+    .unwrap();
+    let model = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let r = certify(
+        &s,
+        &Options {
+            model: Some(model),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(r.certified && r.warnings.is_empty(), "{}", r.summary());
+    assert!(r.checks.iter().any(|c| c == "mechanics"), "{:?}", r.checks);
+}
+
+/// The paper's protocol with Continuous Flow: its scaffold's collisions
+/// are No-Surplus's (the same moves), and the surplus adds its own, each
+/// with a surplus module (pyramid h = 2: 13 and 3).
+#[test]
+fn continuous_flow_keeps_the_papers_collisions_and_adds_the_surplus_ones() {
+    use reconfcheck::algorithms::scaffold::{
+        feed::Feed, flow::Flow, paper::Protocol, scaffold_schedule_flowing,
+    };
+    let spec = ShapeSpec::Pyramid { h: 2 };
+    let run = |flow| {
+        let s =
+            scaffold_schedule_flowing(&spec, 6, Protocol::Paper, Feed::JustInTime, flow).unwrap();
+        let r = certify(&s, &Options::default()).unwrap();
+        (s, r)
+    };
+    let ((plain, r0), (_, r1)) = (run(Flow::NoSurplus), run(Flow::Continuous));
+    let first_surplus = plain.final_module_count() as u32;
+    let key =
+        |v: &reconfcheck::certify::Violation| (v.kind, v.step, v.modules.clone(), v.cells.clone());
+    let old: Vec<_> = r0.violations.iter().map(key).collect();
+    let (scaffold, surplus): (Vec<_>, Vec<_>) = r1
+        .violations
+        .iter()
+        .partition(|v| v.modules.iter().all(|&m| m < first_surplus));
+    assert_eq!(scaffold.into_iter().map(key).collect::<Vec<_>>(), old);
+    assert_eq!((old.len(), surplus.len()), (13, 3));
 }

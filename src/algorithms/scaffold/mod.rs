@@ -8,6 +8,7 @@
 //! * [`paper`] — the paper's own motion constraint and light protocol;
 //! * [`feed`] — when modules leave the sandbox (just in time, or eagerly
 //!   as the authors' implementation feeds them);
+//! * [`flow`] — No-Surplus, or Continuous Flow's surplus on the branches;
 //! * the modules-placed-per-step curves (seed 000 Figs. 13–16) are drawn
 //!   in [`crate::study::scaffold_figures`], not here.
 //!
@@ -16,6 +17,7 @@
 pub mod csg;
 mod csg_text;
 pub mod feed;
+pub mod flow;
 pub mod paper;
 pub mod planner;
 pub mod polytree;
@@ -32,6 +34,7 @@ use crate::lattice::{Cell, LatticeKind};
 use crate::scenario::Scenario;
 use crate::schedule::{Event, Length, ModuleSpec, Schedule, Step};
 use feed::Feed;
+use flow::Flow;
 use paper::Protocol;
 use rustc_hash::FxHashMap;
 use scaffold::Scaffold;
@@ -166,6 +169,23 @@ pub fn scaffold_schedule_with(
     scaffold_schedule_fed(shape, b, protocol, Feed::JustInTime)
 }
 
+/// [`scaffold_schedule_fed`] with surplus modules as `flow` says (see
+/// [`flow`]).
+pub fn scaffold_schedule_flowing(
+    shape: &ShapeSpec,
+    b: u32,
+    protocol: Protocol,
+    feed: Feed,
+    flow: Flow,
+) -> Result<Schedule, InputError> {
+    let s = build_scaffold(shape, b)?;
+    let mut sched = schedule_for(&s, motion_rules(protocol)?, protocol, feed, flow)?;
+    sched
+        .meta
+        .insert("shape".into(), format!("{shape:?}").into());
+    Ok(sched)
+}
+
 /// [`scaffold_schedule_with`], the sandbox releasing modules as `feed`
 /// says (see [`feed`]).
 pub fn scaffold_schedule_fed(
@@ -174,12 +194,7 @@ pub fn scaffold_schedule_fed(
     protocol: Protocol,
     feed: Feed,
 ) -> Result<Schedule, InputError> {
-    let s = build_scaffold(shape, b)?;
-    let mut sched = schedule_for(&s, motion_rules(protocol)?, protocol, feed)?;
-    sched
-        .meta
-        .insert("shape".into(), format!("{shape:?}").into());
-    Ok(sched)
+    scaffold_schedule_flowing(shape, b, protocol, feed, Flow::NoSurplus)
 }
 
 /// Plans every module of a scaffold and writes the schedule: with the
@@ -192,15 +207,26 @@ pub fn schedule_for(
     rules: &dyn MotionRules,
     protocol: Protocol,
     feed: Feed,
+    flow: Flow,
 ) -> Result<Schedule, InputError> {
     schedule_with_border(
         s,
         rules,
         protocol,
         feed,
+        flow,
         polytree::BorderBranches::FirstModules,
     )
-    .or_else(|_| schedule_with_border(s, rules, protocol, feed, polytree::BorderBranches::Whole))
+    .or_else(|_| {
+        schedule_with_border(
+            s,
+            rules,
+            protocol,
+            feed,
+            flow,
+            polytree::BorderBranches::Whole,
+        )
+    })
 }
 
 /// [`schedule_for`] with as much of each border branch early as `border`
@@ -210,6 +236,7 @@ pub fn schedule_with_border(
     rules: &dyn MotionRules,
     protocol: Protocol,
     feed: Feed,
+    flow: Flow,
     border: polytree::BorderBranches,
 ) -> Result<Schedule, InputError> {
     let tree = polytree::Polytree::build_with(
@@ -310,6 +337,11 @@ pub fn schedule_with_border(
             "construction order is cyclic: {planned} of {n} components planned"
         )));
     }
+    let scaffold_complete = planner.horizon();
+    let surplus = match flow {
+        Flow::NoSurplus => None,
+        Flow::Continuous => Some(plan_surplus(s, &mut planner, &mut next_id, &mut sources)),
+    };
     let mut sched = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
     sched.ground = Some(Ground {
         layer: s.sandbox_layer,
@@ -342,6 +374,20 @@ pub fn schedule_with_border(
         .insert("border_branches".into(), border.name().into());
     if let Feed::Eager { window } = feed {
         sched.meta.insert("eager_window".into(), window.into());
+    }
+    sched.meta.insert("flow".into(), flow.name().into());
+    if let Some(surplus) = surplus {
+        let m = &mut sched.meta;
+        m.insert("scaffold_complete_step".into(), scaffold_complete.into());
+        m.insert("surplus_modules".into(), surplus.parked.into());
+        m.insert("surplus_unreached".into(), surplus.unreached.into());
+        m.insert("surplus_chains".into(), surplus.chains.into());
+        let ub = flow::upward_branches(s);
+        m.insert("upward_branches".into(), ub.into());
+        m.insert(
+            "paper_surplus".into(),
+            flow::paper_surplus(ub, s.b as u32).into(),
+        );
     }
     sched.meta.insert("tiles".into(), s.tiles.len().into());
     // Seed 000's Eq. 6 times the critical path: the step at which the
@@ -384,6 +430,88 @@ pub fn schedule_with_border(
     Ok(sched)
 }
 
+/// What Continuous Flow parked (see [`flow`]).
+struct Surplus {
+    parked: usize,
+    unreached: usize,
+    chains: usize,
+}
+
+/// Plans Continuous Flow's surplus modules after the scaffold's: each
+/// chain's parking cells, terminal first, round-robin over the chains.
+fn plan_surplus(
+    s: &Scaffold,
+    planner: &mut planner::Planner,
+    next_id: &mut ModuleId,
+    sources: &mut std::collections::BTreeSet<Cell>,
+) -> Surplus {
+    let chains = flow::chains(s);
+    // Each chain's route over the finished scaffold, entry point first.
+    let routes: Vec<(Cell, Vec<Cell>)> = chains
+        .iter()
+        .map(|c| {
+            let (src, terminal) = (c.source.cell(), c.terminal.cell());
+            let cells = match planner.route(&[(src, 0)], terminal) {
+                Some((_, hops)) if !planner.is_occupied(terminal) => std::iter::once(src)
+                    .chain(hops.iter().map(|h| h.to))
+                    .collect(),
+                _ => Vec::new(),
+            };
+            (src, cells)
+        })
+        .collect();
+    let parking: Vec<Vec<usize>> = routes
+        .iter()
+        .map(|(_, cells)| {
+            let layers: Vec<i32> = cells
+                .iter()
+                .map(|&c| crate::lattice::FccLattice::to_skewed(c).2)
+                .collect();
+            flow::parking_indices(&layers)
+        })
+        .collect();
+    // A chain that climbs a branch and has no route to its terminal
+    // parks nothing: its terminal counts as unreached.
+    let mut out = Surplus {
+        parked: 0,
+        unreached: chains
+            .iter()
+            .zip(&routes)
+            .filter(|(c, (_, cells))| c.branches > 0 && cells.is_empty())
+            .count(),
+        chains: chains.len(),
+    };
+    let rounds = parking.iter().map(Vec::len).max().unwrap_or(0);
+    for r in 0..rounds {
+        for ((src, cells), spots) in routes.iter().zip(&parking) {
+            let Some(&i) = spots.get(r) else { continue };
+            // A cell another chain's module took is that chain's surplus.
+            let tries: Vec<usize> = [i, i - 1]
+                .into_iter()
+                .filter(|&k| k >= flow::PARKING_CLEARANCE && !planner.is_occupied(cells[k]))
+                .collect();
+            let mut parked = false;
+            for k in tries {
+                if planner
+                    .plan_when_route_stands(*next_id, &[(*src, 0)], cells[k])
+                    .is_ok()
+                {
+                    sources.insert(*src);
+                    *next_id += 1;
+                    parked = true;
+                    break;
+                }
+            }
+            if parked {
+                out.parked += 1;
+            } else if !planner.is_occupied(cells[i]) {
+                out.unreached += 1;
+            }
+        }
+    }
+    out
+}
+
 /// Scenario parameters of the `scaffold` generator.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -409,6 +537,9 @@ struct Params {
     /// departure a module may leave (default [`feed::EAGER_WINDOW`]).
     #[serde(default)]
     eager_window: Option<u32>,
+    /// "no-surplus" (default) or "continuous" (see [`flow::Flow`]).
+    #[serde(default)]
+    flow: Option<String>,
 }
 
 /// The widest `eager_window` a scenario may ask for: each step of window
@@ -507,6 +638,14 @@ impl Generator for ScaffoldAssembly {
                 ));
             }
         };
-        scaffold_schedule_fed(&spec, p.b, protocol, feed).map_err(|e| e.in_file(&scenario.path))
+        let flow = choice(
+            scenario,
+            "flow",
+            p.flow.as_deref(),
+            Flow::parse,
+            "no-surplus, continuous",
+        )?;
+        scaffold_schedule_flowing(&spec, p.b, protocol, feed, flow)
+            .map_err(|e| e.in_file(&scenario.path))
     }
 }

@@ -162,6 +162,11 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// Whether a static module holds `c` once everything planned is in place.
+    pub fn is_occupied(&self, c: Cell) -> bool {
+        self.occupied.contains(&c)
+    }
+
     /// Last step of the schedule so far.
     pub fn horizon(&self) -> usize {
         self.positions.len() - 1
@@ -424,20 +429,56 @@ impl<'a> Planner<'a> {
         dst: Cell,
         ready: usize,
     ) -> Result<(Cell, usize), InputError> {
+        let (src, hops) = self.route_or_explain(id, srcs, dst)?;
+        Ok((src, self.commit(id, src, &hops, dst, ready)))
+    }
+
+    /// Plans module `id` to `dst` as [`Planner::plan`] does, ready as soon
+    /// as its route stands: every pivot in place and every earlier use of
+    /// `dst` over (a surplus module, [`super::flow`], has no component
+    /// waiting for it).
+    pub fn plan_when_route_stands(
+        &mut self,
+        id: ModuleId,
+        srcs: &[(Cell, u32)],
+        dst: Cell,
+    ) -> Result<(Cell, usize), InputError> {
+        let (src, hops) = self.route_or_explain(id, srcs, dst)?;
+        let ready = hops
+            .iter()
+            .map(|h| self.module_at.get(&h.pivot).map_or(0, |&(_, at)| at))
+            .chain(self.last_use.get(&dst).copied())
+            .max()
+            .unwrap_or(0);
+        Ok((src, self.commit(id, src, &hops, dst, ready)))
+    }
+
+    fn route_or_explain(
+        &mut self,
+        id: ModuleId,
+        srcs: &[(Cell, u32)],
+        dst: Cell,
+    ) -> Result<(Cell, Vec<Hop>), InputError> {
         let t_route = std::time::Instant::now();
         let routed = self.route(srcs, dst);
         self.timing.0 += t_route.elapsed().as_secs_f64();
-        let t_follow = std::time::Instant::now();
-        let (src, hops) = routed.ok_or_else(|| {
+        routed.ok_or_else(|| {
             InputError::new(format!(
                 "no sequence of rotations leads from any entry point to cell {dst} over the structure \
                  built so far"
             ))
             .for_module(id)
-        })?;
+        })
+    }
+
+    /// Follows `hops` in time from `src`, arriving at `dst` after step
+    /// `ready`, and reserves the module's cells, sweeps and events.
+    /// Returns the step at the end of which it is in place.
+    fn commit(&mut self, id: ModuleId, src: Cell, hops: &[Hop], dst: Cell, ready: usize) -> usize {
+        let t_follow = std::time::Instant::now();
         let mut t0 = (ready + 1).saturating_sub(hops.len()).max(1);
         let (mut cells, mut steps) = loop {
-            if let Some(found) = self.follow(t0, src, &hops, ready) {
+            if let Some(found) = self.follow(t0, src, hops, ready) {
                 break found;
             }
             t0 += 1;
@@ -452,7 +493,7 @@ impl<'a> Planner<'a> {
                 if arrival == soonest {
                     break;
                 }
-                if let Some((c, s)) = self.follow(e, src, &hops, ready) {
+                if let Some((c, s)) = self.follow(e, src, hops, ready) {
                     let a = *s.last().unwrap_or(&e);
                     if a < arrival {
                         (arrival, t0, cells, steps) = (a, e, c, s);
@@ -509,7 +550,7 @@ impl<'a> Planner<'a> {
         self.placed_per_step[arrival - 1] += 1;
         self.occupied.insert(dst);
         self.module_at.insert(dst, (id, arrival));
-        Ok((src, arrival))
+        arrival
     }
 }
 
