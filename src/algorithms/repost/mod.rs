@@ -137,6 +137,9 @@ pub struct PlannerParams {
     pub goal: String,
     #[serde(default = "default_spacing")]
     pub spacing_mm: f64,
+    /// "paper" (default) or "bottom-up" (see [`planner::GoalOrder`]).
+    #[serde(default)]
+    pub goal_order: Option<String>,
 }
 
 /// The schedule of a planned reconfiguration: ground under the lowest
@@ -172,6 +175,8 @@ pub fn planner_schedule(p: &planner::Plan, spacing_mm: f64) -> Schedule {
         "source_width".into(),
         p.source_width.map_or("every leaf".into(), |w| w.into()),
     );
+    s.meta
+        .insert("goal_order".into(), p.goal_order.name().into());
     s.meta.insert(
         "iteration_detail".into(),
         serde_json::to_value(&p.iterations).expect("iterations serialise"),
@@ -219,7 +224,15 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
     let goal = shape::load(&gp)?;
     let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
         .expect("the FCC lattice has derived motion rules");
-    let plan = planner::plan(&initial, &goal, rules).map_err(|e| {
+    let order = match p.goal_order.as_deref() {
+        None => planner::GoalOrder::default(),
+        Some(name) => planner::GoalOrder::parse(name).ok_or_else(|| {
+            scenario.error(format!(
+                "unknown goal_order '{name}' in parameter goal_order (known: paper, bottom-up)"
+            ))
+        })?,
+    };
+    let plan = planner::plan(&initial, &goal, rules, order).map_err(|e| {
         let file = match e {
             planner::PlanError::Bound { .. }
             | planner::PlanError::Catoms { .. }

@@ -100,6 +100,37 @@ pub struct Iteration {
     pub messages: Messages,
 }
 
+/// Which empty goal cells an iteration may assign to destinations.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Default)]
+pub enum GoalOrder {
+    /// The paper's rule (§V): every empty goal cell next to a SPARSE goal
+    /// meta-module, one destination per cell and one cell per destination.
+    #[default]
+    Paper,
+    /// Stricter, ours: a goal cell also waits until the cell below it is
+    /// built (no meta-module hangs from its destination while it is
+    /// assembled). On L → C: 11 iterations against the paper's 7.
+    BottomUp,
+}
+
+impl GoalOrder {
+    /// Parses a scenario's `goal_order` parameter.
+    pub fn parse(s: &str) -> Option<GoalOrder> {
+        match s {
+            "paper" => Some(GoalOrder::Paper),
+            "bottom-up" => Some(GoalOrder::BottomUp),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            GoalOrder::Paper => "paper",
+            GoalOrder::BottomUp => "bottom-up",
+        }
+    }
+}
+
 /// The plan: the initial catoms and the steps of rotations.
 #[derive(Clone, Debug, Default)]
 pub struct Plan {
@@ -113,6 +144,8 @@ pub struct Plan {
     /// The source rule that planned: `None` every leaf, `Some(w)` leaves
     /// within `w` BFS levels of the deepest (see [`plan`]).
     pub source_width: Option<usize>,
+    /// The goal cells' order the plan was made with.
+    pub goal_order: GoalOrder,
 }
 
 /// The cells of a meta-module's box: where its catoms and the catoms
@@ -148,8 +181,9 @@ pub fn plan(
     initial: &BTreeMap<Meta, State>,
     goal: &BTreeMap<Meta, State>,
     rules: &dyn MotionRules,
+    order: GoalOrder,
 ) -> Result<Plan, PlanError> {
-    let first = match plan_with(initial, goal, rules, None) {
+    let first = match plan_with(initial, goal, rules, order, None) {
         Ok(p) => return Ok(p),
         Err(e @ (PlanError::Bound { .. } | PlanError::NoCoordinator)) => return Err(e),
         Err(e) => e,
@@ -159,7 +193,7 @@ pub fn plan(
         tree.depth.into_values().max().unwrap_or(0)
     });
     for w in (0..deepest).rev() {
-        if let Ok(p) = plan_with(initial, goal, rules, Some(w)) {
+        if let Ok(p) = plan_with(initial, goal, rules, order, Some(w)) {
             return Ok(p);
         }
     }
@@ -172,6 +206,7 @@ fn plan_with(
     initial: &BTreeMap<Meta, State>,
     goal: &BTreeMap<Meta, State>,
     rules: &dyn MotionRules,
+    order: GoalOrder,
     width: Option<usize>,
 ) -> Result<Plan, PlanError> {
     let held = |m: &BTreeMap<Meta, State>| -> usize {
@@ -211,6 +246,7 @@ fn plan_with(
         modules,
         ground,
         source_width: width,
+        goal_order: order,
         ..Default::default()
     };
     loop {
@@ -258,13 +294,15 @@ fn plan_with(
         }
         sources.extend(&full);
         // 2. Destinations: one per empty goal cell, lowest cells first.
-        // Built bottom-up: a goal cell whose cell below is empty waits
-        // (a meta-module would otherwise hang from its destination).
+        // Bottom-up (not the paper's): a goal cell whose cell below is
+        // empty waits.
         let low = goal.keys().map(|m| m.z).min().unwrap_or(0);
         let mut empty_sorted: Vec<Meta> = empty
             .iter()
             .filter(|m| {
-                m.z == low || state.contains_key(&m.step(super::metamodule::Direction::Down))
+                order == GoalOrder::Paper
+                    || m.z == low
+                    || state.contains_key(&m.step(super::metamodule::Direction::Down))
             })
             .copied()
             .collect();
