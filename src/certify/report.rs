@@ -298,6 +298,7 @@ impl Report {
         let covered = match self.stopped_at {
             Some(k) if k < first => "no step".to_string(),
             Some(k) => format!("steps {first}–{k}"),
+            None if self.steps == 0 => "no steps: the configuration".to_string(),
             None if last == self.steps => {
                 format!("steps {first}–{last} and the final configuration")
             }
@@ -517,6 +518,18 @@ mod tests {
             s.contains("NOT checked: mechanics: lattice checks only (--lattice-only)"),
             "{s}"
         );
+    }
+
+    #[test]
+    fn a_schedule_of_no_steps_is_checked_as_its_configuration_not_steps_1_to_0() {
+        let mut r = report(Vec::new(), Vec::new());
+        r.steps = 0;
+        let s = r.summary();
+        assert!(
+            s.contains("checked: lattice (no steps: the configuration)"),
+            "{s}"
+        );
+        assert!(!s.contains("1–0"), "{s}");
     }
 
     #[test]
