@@ -78,6 +78,25 @@ pub fn generate(scenario: &Scenario) -> Result<Schedule, InputError> {
     Ok(s)
 }
 
+/// A named choice among `known`: its default when the scenario leaves it
+/// out, an error naming the scenario and the parameter when unknown.
+pub(crate) fn choice<T: Default>(
+    scenario: &Scenario,
+    param: &str,
+    value: Option<&str>,
+    parse: fn(&str) -> Option<T>,
+    known: &str,
+) -> Result<T, InputError> {
+    match value {
+        None => Ok(T::default()),
+        Some(name) => parse(name).ok_or_else(|| {
+            scenario.error(format!(
+                "unknown {param} '{name}' in parameter {param} (known: {known})"
+            ))
+        }),
+    }
+}
+
 /// Reads a generator's parameters from the scenario's `[parameters]` table.
 pub fn parameters<P: DeserializeOwned>(scenario: &Scenario) -> Result<P, InputError> {
     scenario.parameters.clone().try_into().map_err(|e| {

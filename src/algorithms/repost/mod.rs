@@ -224,14 +224,13 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
     let goal = shape::load(&gp)?;
     let rules = crate::geometry::motion_rules(LatticeKind::Fcc)
         .expect("the FCC lattice has derived motion rules");
-    let order = match p.goal_order.as_deref() {
-        None => planner::GoalOrder::default(),
-        Some(name) => planner::GoalOrder::parse(name).ok_or_else(|| {
-            scenario.error(format!(
-                "unknown goal_order '{name}' in parameter goal_order (known: paper, bottom-up)"
-            ))
-        })?,
-    };
+    let order = super::choice(
+        scenario,
+        "goal_order",
+        p.goal_order.as_deref(),
+        planner::GoalOrder::parse,
+        "paper, bottom-up",
+    )?;
     let plan = planner::plan(&initial, &goal, rules, order).map_err(|e| {
         let file = match e {
             planner::PlanError::Bound { .. }

@@ -26,7 +26,7 @@ pub mod scaffold;
 pub mod shape;
 pub mod vs_csg;
 
-use super::{Generator, parameters};
+use super::{Generator, choice, parameters};
 use crate::error::InputError;
 use crate::geometry::MotionRules;
 use crate::lattice::config::{Ground, ModuleId};
@@ -549,25 +549,6 @@ const MAX_EAGER_WINDOW: u32 = 1000;
 
 fn default_b() -> u32 {
     6
-}
-
-/// A named choice among `known`: its default when the scenario leaves it
-/// out, an error naming the scenario and the parameter when unknown.
-fn choice<T: Default>(
-    scenario: &Scenario,
-    param: &str,
-    value: Option<&str>,
-    parse: fn(&str) -> Option<T>,
-    known: &str,
-) -> Result<T, InputError> {
-    match value {
-        None => Ok(T::default()),
-        Some(name) => parse(name).ok_or_else(|| {
-            scenario.error(format!(
-                "unknown {param} '{name}' in parameter {param} (known: {known})"
-            ))
-        }),
-    }
 }
 
 /// The `scaffold` generator (seed 000).
