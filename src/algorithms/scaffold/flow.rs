@@ -181,6 +181,35 @@ mod tests {
         assert_eq!(parking_indices(&[-1, 0, 1, 1, 1, 3, 3]), vec![6, 4]);
     }
 
+    /// Chains are disjoint and climb every whole upward branch once: an
+    /// h-pyramid has 4·Σ k² of them (k = 1 … h − 1), each ground tile
+    /// starts four chains, and every terminal is a free cell.
+    #[test]
+    fn an_h_pyramids_chains_climb_each_upward_branch_once_to_a_free_terminal() {
+        use crate::algorithms::scaffold::{ShapeSpec, build_scaffold};
+        for h in 2..=5u32 {
+            let s = build_scaffold(&ShapeSpec::Pyramid { h }, 6).unwrap();
+            let c = chains(&s);
+            assert_eq!(c.len(), 4 * (h * h) as usize, "h = {h}");
+            let whole: usize = (1..h as usize).map(|k| 4 * k * k).sum();
+            assert_eq!(
+                c.iter().map(|c| c.branches).sum::<usize>(),
+                whole,
+                "h = {h}"
+            );
+            assert_eq!(upward_branches(&s), whole, "h = {h}");
+            let mut climbed = std::collections::BTreeSet::new();
+            for ch in &c {
+                assert_eq!(ch.tiles.len(), ch.branches + 1);
+                for w in ch.tiles.windows(2) {
+                    assert!(climbed.insert((w[0], w[1])), "h = {h}: {w:?} climbed twice");
+                }
+                let free = !s.index.contains_key(&ch.terminal) && !s.sandbox.contains(&ch.terminal);
+                assert!(free, "h = {h}: {:?}", ch.terminal);
+            }
+        }
+    }
+
     #[test]
     fn flow_names_round_trip() {
         for f in [Flow::NoSurplus, Flow::Continuous] {
