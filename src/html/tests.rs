@@ -11,6 +11,14 @@ fn scaffold() -> Schedule {
     crate::algorithms::generate(&sc).unwrap()
 }
 
+/// The shipped physical model: its path (for `Options::model`) and the
+/// model itself.
+fn shipped_model() -> (std::path::PathBuf, crate::mechanics::Model) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let model = crate::mechanics::Model::load(&path).unwrap();
+    (path, model)
+}
+
 /// The bundled walk's first steps with a fixed module at (1, −1, 1), which
 /// its first rotation cuts (as `tests/common`'s obstacle walk).
 fn colliding_walk() -> Schedule {
@@ -119,8 +127,7 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
 #[test]
 fn a_span_of_steps_has_load_maps_of_its_steps_only() {
     let s = scaffold();
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
-    let model = crate::mechanics::Model::load(&path).unwrap();
+    let (path, model) = shipped_model();
     let opts = Options {
         model: Some(path),
         steps: Some(certify::StepRequest::parse("30-40").unwrap()),
@@ -220,10 +227,7 @@ fn text_that_would_end_a_script_element_stays_inside_the_data() {
 #[test]
 fn a_load_map_colours_every_connector_by_its_utilisation() {
     let s = scaffold();
-    let model = crate::mechanics::Model::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml"),
-    )
-    .unwrap();
+    let (_, model) = shipped_model();
     let last = s.steps.len() + 1;
     let maps = certify::load_maps_at(&s, &model, &[3, last]).unwrap();
     assert_eq!(maps.iter().map(|m| m.0).collect::<Vec<_>>(), [3, last]);
@@ -238,8 +242,7 @@ fn a_load_map_colours_every_connector_by_its_utilisation() {
 #[test]
 fn every_step_has_a_load_map_when_they_fit_and_the_budget_holds_when_not() {
     let s = scaffold();
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
-    let model = crate::mechanics::Model::load(&path).unwrap();
+    let (path, model) = shipped_model();
     let opts = Options {
         model: Some(path),
         ..Options::default()

@@ -119,3 +119,23 @@ pub fn branch_study_page(page: &std::path::Path, lo: usize, hi: usize) {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{o:?}");
 }
+
+/// Where every module of a schedule of rolling modules ends: the
+/// initial cells, then each `enter` and rotation in order (any other
+/// event is not expected there).
+pub fn final_cells(s: &Schedule) -> std::collections::BTreeMap<u32, Cell> {
+    let mut at: std::collections::BTreeMap<u32, Cell> =
+        s.modules.iter().map(|m| (m.id, m.cell)).collect();
+    for e in s.steps.iter().flat_map(|st| &st.events) {
+        match e {
+            Event::Enter { module, cell } => {
+                at.insert(*module, *cell);
+            }
+            Event::Rotate { module, to, .. } => {
+                at.insert(*module, *to);
+            }
+            other => panic!("a schedule of rolling modules has no {other:?}"),
+        }
+    }
+    at
+}

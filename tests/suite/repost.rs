@@ -234,16 +234,7 @@ fn ends_on(s: &reconfcheck::schedule::Schedule, path: &std::path::Path) {
         .iter()
         .flat_map(|(m, st): (&Meta, &State)| m.cells(*st))
         .collect();
-    let mut at: std::collections::BTreeMap<u32, Cell> =
-        s.modules.iter().map(|m| (m.id, m.cell)).collect();
-    for st in &s.steps {
-        for e in &st.events {
-            if let reconfcheck::schedule::Event::Rotate { module, to, .. } = e {
-                at.insert(*module, *to);
-            }
-        }
-    }
-    let mut got: Vec<Cell> = at.into_values().collect();
+    let mut got: Vec<Cell> = common::final_cells(s).into_values().collect();
     want.sort();
     got.sort();
     assert_eq!(got, want, "the catoms do not end on the loops of {file}");

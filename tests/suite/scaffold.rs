@@ -670,27 +670,6 @@ fn the_authors_plated_sandcastle_and_domed_cube_are_accepted_and_the_bowled_cube
     assert!(e.message.contains("overhangs"), "{}", e.message);
 }
 
-/// Where every module of `s` ends (sandbox, scaffold and surplus).
-fn final_cells(
-    s: &reconfcheck::schedule::Schedule,
-) -> std::collections::BTreeMap<u32, reconfcheck::lattice::Cell> {
-    use reconfcheck::schedule::Event;
-    let mut at: std::collections::BTreeMap<u32, _> =
-        s.modules.iter().map(|m| (m.id, m.cell)).collect();
-    for e in s.steps.iter().flat_map(|st| &st.events) {
-        match e {
-            Event::Enter { module, cell } => {
-                at.insert(*module, *cell);
-            }
-            Event::Rotate { module, to, .. } => {
-                at.insert(*module, *to);
-            }
-            other => panic!("a scaffold schedule has no {other:?}"),
-        }
-    }
-    at
-}
-
 /// Continuous Flow (seed 000 §4.3.1, `flow = "continuous"`): the surplus
 /// is planned after the scaffold, so the scaffold's modules make the
 /// No-Surplus moves step for step; the surplus parks on the chains of
@@ -726,13 +705,14 @@ fn continuous_flow_parks_surplus_on_the_branches_without_changing_the_scaffolds_
             assert_eq!(scaffold, expected, "h = {h}, step {}", k + 1);
         }
         let whole: usize = (1..h as usize).map(|k| 4 * k * k).sum();
-        let ends = final_cells(&flowing);
+        let ends = common::final_cells(&flowing);
         let surplus: Vec<_> = ends.range(first_surplus..).map(|(_, &c)| c).collect();
         assert_eq!(surplus.len(), 2 * whole, "h = {h}");
         assert_eq!(flowing.meta["surplus_modules"], 2 * whole);
         assert_eq!(flowing.meta["surplus_unreached"], 0);
         assert_eq!(flowing.meta["scaffold_complete_step"], plain.steps.len());
-        let scaffold: std::collections::BTreeSet<_> = final_cells(&plain).into_values().collect();
+        let scaffold: std::collections::BTreeSet<_> =
+            common::final_cells(&plain).into_values().collect();
         let l = FccLattice;
         for &c in &surplus {
             assert!(

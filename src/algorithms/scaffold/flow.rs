@@ -26,10 +26,11 @@
 //! * the chain's surplus modules **park** on the route a module takes
 //!   from the entry point to the terminal (the planner's own route over
 //!   the finished scaffold): the terminal, then, back towards the
-//!   sandbox, a cell every second layer ([`PARKING_GAP`]: one beside
-//!   every second module of a branch, the paper's `b/2` per branch, none
-//!   touching another), leaving the entry point and the cell after it
-//!   free ([`PARKING_CLEARANCE`]);
+//!   sandbox, a cell every second layer ([`PARKING_GAP`]: aiming at one
+//!   beside every second module of a branch, the paper's `b/2`, with none
+//!   touching another; routes that climb two layers in one rotation skip
+//!   layers, so ⌊(b − 1)/2⌋ park per whole branch, measured), leaving the
+//!   entry point and the cell after it free ([`PARKING_CLEARANCE`]);
 //! * the coordinators regulate the flow by construction needs, so the
 //!   scaffold's modules have priority: the surplus is planned after every
 //!   scaffold module, into the space and time they leave free. The
@@ -44,10 +45,12 @@
 use super::scaffold::{Dir, Scaffold};
 use super::shape::Skew;
 
-/// How many skewed layers apart two parked surplus modules of a chain
-/// stand: one beside every second module of a branch (the paper's `b/2`
-/// per branch), and never two touching (lattice neighbours are at most
-/// one layer apart), so each hangs on the scaffold, not on another.
+/// At least how many skewed layers apart two parked surplus modules of a
+/// chain stand: at most one beside every second module of a branch (the
+/// paper's `b/2` per branch, which the routes' two-layer rotations bring
+/// down to ⌊(b − 1)/2⌋), and never two touching (lattice neighbours are
+/// at most one layer apart), so each hangs on the scaffold, not on
+/// another.
 pub const PARKING_GAP: i32 = 2;
 
 /// Route cells kept free at the sandbox end of a chain: the entry point,
