@@ -151,7 +151,14 @@ pub struct Analysis {
     /// Components judged at the samples alone, each with why (see
     /// [`SampledOnly`]). Between their samples the verdict is not proved.
     pub sampled_only: Vec<SampledOnly>,
+    /// The critical element: the most utilised link or hold, or, where a
+    /// component the limit analysis judged fails, the link its collapse
+    /// mechanism works hardest (else its elastic estimate's most loaded).
     pub critical: Option<Critical>,
+    /// Where the critical component fails by the limit analysis: its
+    /// collapse mechanism at the pose of its smallest factor (links of
+    /// `Structure::links` with their shares of the dissipated work).
+    pub mechanism: Option<limit::Mechanism>,
     pub verdict: Option<Verdict>,
     /// CG iterations (preconditioned by a kept factor, or refining a fresh
     /// one) and sparse factorisations this analysis took.
@@ -269,7 +276,7 @@ struct SweepJudged {
 
 /// The limit analysis of one component over the poses the screen could not
 /// clear.
-#[derive(Copy, Clone, Debug)]
+#[derive(Clone, Debug)]
 struct LimitOutcome {
     /// With connectors rigid, the smallest factor over the failing poses:
     /// below 1, the component tips or slides there (∞, not solved, when
@@ -291,6 +298,9 @@ struct LimitOutcome {
     /// The solver setting the first limit analysis needed
     /// ([`Analyzer::limit_setting`]).
     setting: usize,
+    /// The collapse mechanism of the solved pose with the smallest factor,
+    /// where that factor fails (below 1) and the solve gives one.
+    mechanism: Option<limit::Mechanism>,
 }
 
 /// Solver settings.
@@ -1810,6 +1820,7 @@ impl Analyzer {
             partial: false,
             lower: 1.0 / bound,
             setting: self.limit_setting,
+            mechanism: None,
         }
     }
 
@@ -1839,6 +1850,7 @@ impl Analyzer {
             partial: false,
             lower: f64::INFINITY,
             setting: self.limit_setting,
+            mechanism: None,
         };
         let part = limit::Part {
             bodies: &comps.bodies[c],
@@ -1846,18 +1858,10 @@ impl Analyzer {
         };
         let dominated = dominated_samples(s, failing);
         let tolerance = self.settings.load_factor_tolerance;
+        // Equilibria are kept only to bound later poses.
         let solve_pose = |pose: Option<usize>, start: usize| {
             let loads = body_loads(s, pose);
-            let (model, c) = (&self.model, Connectors::Capacities);
-            // Equilibria are kept only to bound later poses.
-            if tolerance > 0.0 {
-                limit::load_factor_with_field(s, model, &loads, part, c, start)
-            } else {
-                (
-                    limit::load_factor_from(s, model, &loads, part, c, start),
-                    None,
-                )
-            }
+            limit::solve_with_capacities(s, &self.model, &loads, part, start, tolerance > 0.0)
         };
         // Where the bisection applies, the worst pose first, alone: a
         // failing step usually fails there, and the enumeration below then
@@ -1871,11 +1875,11 @@ impl Analyzer {
             && let Some(i0) = (0..failing.len()).find(|&i| !dominated[i])
         {
             let r = solve_pose(failing[i0].0, start);
-            if r.0.setting < limit::SETTINGS.len() {
-                start = r.0.setting;
+            if r.result.setting < limit::SETTINGS.len() {
+                start = r.result.setting;
             }
-            if !fails(r.0.lambda) {
-                let known = failing[i0].0.map(|k| (k, r.0.lambda));
+            if !fails(r.result.lambda) {
+                let known = failing[i0].0.map(|k| (k, r.result.lambda));
                 let (bisected, setting, reused) =
                     self.bisect(s, &sweep, part, failing, known, start);
                 out.capacities = bisected.smallest;
@@ -1883,6 +1887,17 @@ impl Analyzer {
                 out.partial = bisected.partial;
                 out.runs = bisected.solves + 1 - reused;
                 out.setting = setting;
+                // The bisection keeps factors only: where a solved pose
+                // fails, it is solved once more for its mechanism.
+                let worst = bisected
+                    .poses
+                    .iter()
+                    .filter(|(_, lf)| fails(*lf))
+                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+                if let Some(&(k, _)) = worst {
+                    out.runs += 1;
+                    out.mechanism = solve_pose(Some(k), setting).mechanism;
+                }
                 self.rigid(s, part, failing, &mut out);
                 return out;
             }
@@ -1893,8 +1908,7 @@ impl Analyzer {
         // as there are threads, ahead of the sequential logic below, which
         // alone decides what counts and, with a tolerance, which poses a
         // solved one spares: results do not depend on threads.
-        let mut solved: Vec<Option<(limit::LimitResult, Option<limit::Field>)>> =
-            failing.iter().map(|_| None).collect();
+        let mut solved: Vec<Option<limit::Solved>> = failing.iter().map(|_| None).collect();
         let mut fields: Vec<(Option<usize>, limit::Field)> = Vec::new();
         let mut wave = 1;
         // The setting the first solve needed starts the others
@@ -1961,7 +1975,7 @@ impl Analyzer {
                     .map(|&j| solve_pose(failing[j].0, start))
                     .collect();
                 if first_wave {
-                    let setting = results[0].0.setting;
+                    let setting = results[0].result.setting;
                     if setting < limit::SETTINGS.len() {
                         start = setting;
                     }
@@ -1972,13 +1986,24 @@ impl Analyzer {
                 }
                 wave = rayon::current_num_threads().max(1);
             }
-            let (cap, field) = solved[i]
+            let limit::Solved {
+                result: cap,
+                field,
+                mechanism,
+            } = solved[i]
                 .take()
                 .expect("solved in this wave or an earlier one");
             if let Some(f) = field {
                 fields.push((pose, f));
             }
             out.runs += 1;
+            // The mechanism of the smallest factor; a failed solve (NaN,
+            // which sticks as the factor) has none.
+            if cap.lambda.is_nan() {
+                out.mechanism = None;
+            } else if fails(cap.lambda) && cap.lambda < out.capacities {
+                out.mechanism = mechanism;
+            }
             out.capacities = lowest(out.capacities, cap.lambda);
             out.lower = lowest(out.lower, cap.lambda);
             failed = fails(cap.lambda);
@@ -2270,16 +2295,24 @@ impl Analyzer {
             let u = severity(1.0 / l.capacities).max(l.admissible);
             if u > max || crit.is_none() {
                 max = u;
-                // The most loaded link of the elastic estimate names where.
-                crit = comps.links[*c]
-                    .iter()
-                    .copied()
-                    .max_by(|&a, &b| {
-                        severity(out.links[a].utilisation)
-                            .total_cmp(&severity(out.links[b].utilisation))
-                    })
-                    .map(Critical::Link)
-                    .or(crit);
+                // Where it gives way names where: the link its collapse
+                // mechanism works hardest; without one (a pose the
+                // bisection bounded but did not solve), the most loaded
+                // link of the elastic estimate.
+                let mechanism = l.mechanism.as_ref().filter(|m| !m.links.is_empty());
+                out.mechanism = mechanism.cloned();
+                crit = match mechanism {
+                    Some(m) => Some(Critical::Link(m.links[0].0)),
+                    None => comps.links[*c]
+                        .iter()
+                        .copied()
+                        .max_by(|&a, &b| {
+                            severity(out.links[a].utilisation)
+                                .total_cmp(&severity(out.links[b].utilisation))
+                        })
+                        .map(Critical::Link)
+                        .or(crit),
+                };
             }
             if overloaded(1.0 / l.capacities) {
                 any_overloaded = true;

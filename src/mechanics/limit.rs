@@ -143,17 +143,61 @@ pub struct Field {
     lambda: f64,
 }
 
-/// [`load_factor_from`], with the equilibrium that carries it (none for
-/// the rigid case, a failed solve, or a part held by a fixed module).
-pub fn load_factor_with_field(
+/// Where a structure that fails gives way: the collapse mechanism of
+/// the limit analysis, read from the solver's dual (the upper-bound
+/// theorem's virtual velocities). The dual of each capacity row is the
+/// rate at which its corner yields; times the row's capacity it is the
+/// work the corner dissipates, and the links' works sum to `λ` (strong
+/// duality: the loads' work at unit rate). A link's share of that sum says
+/// how much of the collapse happens there. A ground contact without
+/// adhesion dissipates nothing (its capacity rows are 0): it lifts or
+/// slides freely and is never named.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mechanism {
+    /// `(link, share)`, largest share first, the shares of every link
+    /// summing to 1; links below [`MECHANISM_FLOOR`] left out.
+    pub links: Vec<(usize, f64)>,
+}
+
+/// The smallest share of the dissipated work a link of a [`Mechanism`]
+/// keeps: below it, the interior-point dual's round-off.
+pub const MECHANISM_FLOOR: f64 = 1e-4;
+
+/// One limit analysis with capacities, everything it can tell.
+pub struct Solved {
+    pub result: LimitResult,
+    /// The equilibrium that carries the factor, if asked for (none for a
+    /// failed solve, or a part held by a fixed module).
+    pub field: Option<Field>,
+    /// Where it gives way (none where the solve failed, the part is held
+    /// by a fixed module, or the factor is 0: no work to share).
+    pub mechanism: Option<Mechanism>,
+}
+
+/// [`load_factor_from`] with capacities, with its collapse mechanism and,
+/// if `keep_field`, the equilibrium that carries it.
+pub fn solve_with_capacities(
     s: &Structure,
     model: &Model,
     loads: &[Vec6],
     part: Part<'_>,
-    which: Connectors,
     first: usize,
-) -> (LimitResult, Option<Field>) {
-    solve(s, model, loads, part, which, true, first)
+    keep_field: bool,
+) -> Solved {
+    let (result, field, mechanism) = solve_full(
+        s,
+        model,
+        loads,
+        part,
+        Connectors::Capacities,
+        keep_field,
+        first,
+    );
+    Solved {
+        result,
+        field,
+        mechanism,
+    }
 }
 
 /// The largest multiple of the action of side `a` on side `b` through
@@ -190,7 +234,7 @@ pub fn link_load_factor(
     capacity_rows(&mut prog, s, model, &[li]);
     let to_prove = prog.clone();
     proof::reserve_pressure(&mut prog);
-    let (r, x) = maximise(prog, 0);
+    let (r, x, _) = maximise(prog, 0);
     if r.lambda.is_nan() {
         return f64::NAN;
     }
@@ -270,7 +314,7 @@ pub fn region_load_factor(
     }
     let to_prove = prog.clone();
     proof::reserve_pressure(&mut prog);
-    let (r, x) = maximise(prog, first);
+    let (r, x, _) = maximise(prog, first);
     if r.lambda.is_nan() {
         return f64::NAN;
     }
@@ -308,6 +352,19 @@ fn solve(
     keep_field: bool,
     first: usize,
 ) -> (LimitResult, Option<Field>) {
+    let (r, field, _) = solve_full(s, model, loads, part, which, keep_field, first);
+    (r, field)
+}
+
+fn solve_full(
+    s: &Structure,
+    model: &Model,
+    loads: &[Vec6],
+    part: Part<'_>,
+    which: Connectors,
+    keep_field: bool,
+    first: usize,
+) -> (LimitResult, Option<Field>, Option<Mechanism>) {
     let rigid = which == Connectors::Rigid;
     let Some((mut prog, links)) = program(s, model, loads, part, rigid) else {
         // Held by a fixed module through rigid connectors: any load.
@@ -318,16 +375,17 @@ fn solve(
             setting: 0,
             solver_lambda: LAMBDA_CAP,
         };
-        return (r, None);
+        return (r, None, None);
     };
     if rigid {
         // Only a failing component is asked whether it stands rigidly
         // (tips or slides): no verdict rests on this factor.
-        return (maximise(prog, first).0, None);
+        return (maximise(prog, first).0, None, None);
     }
     let to_prove = prog.clone();
     proof::reserve_pressure(&mut prog);
-    let (mut r, x) = maximise(prog, first);
+    let (mut r, x, work) = maximise(prog, first);
+    let mechanism = work.and_then(|w| mechanism(&links, &w));
     let proof = x.and_then(|x| proof::prove(&to_prove, &x, r.lambda));
     r.solver_lambda = r.lambda;
     if !r.lambda.is_nan() {
@@ -340,7 +398,31 @@ fn solve(
             x: p.v.iter().map(|v| v * p.lambda).collect(),
             lambda: p.lambda,
         });
-    (r, field)
+    (r, field, mechanism)
+}
+
+/// Each link's share of the dissipated work `work` (one entry per
+/// capacity row, [`CAPACITY_ROWS`] per link in the order of `links`);
+/// `None` where nothing is dissipated (a factor of 0) or a figure is not
+/// finite.
+fn mechanism(links: &[usize], work: &[f64]) -> Option<Mechanism> {
+    debug_assert_eq!(work.len(), CAPACITY_ROWS * links.len());
+    let per_link: Vec<f64> = work
+        .chunks(CAPACITY_ROWS)
+        .map(|rows| rows.iter().map(|w| w.max(0.0)).sum())
+        .collect();
+    let total: f64 = per_link.iter().sum();
+    if !(total.is_finite() && total > 0.0) {
+        return None;
+    }
+    let mut shares: Vec<(usize, f64)> = links
+        .iter()
+        .zip(&per_link)
+        .map(|(&li, &w)| (li, w / total))
+        .filter(|&(_, share)| share >= MECHANISM_FLOOR)
+        .collect();
+    shares.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    Some(Mechanism { links: shares })
 }
 
 /// The conic program of `part` under `loads` (equilibrium rows, capacity
@@ -403,6 +485,9 @@ fn largest_residual(rows: &[f64]) -> f64 {
 /// > 0), the tangential force `(t_u, t_v)` and its bound `z ≥ ‖t‖`.
 const PER_CORNER: usize = 4;
 const PER_LINK: usize = 4 * PER_CORNER;
+/// Capacity rows per link ([`capacity_rows`]): four of adhesion, four of
+/// friction.
+const CAPACITY_ROWS: usize = 8;
 const CORNERS: [(f64, f64); 4] = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
 
 /// The conic program being assembled: `A x + s = b`, `s` in the zero cone
@@ -595,10 +680,13 @@ fn capacity_rows(prog: &mut Program, s: &Structure, model: &Model, links: &[usiz
 pub const SETTINGS: [(f64, f64); 4] = [(1e-8, 1e-8), (1e-7, 1e-8), (1e-6, 1e-7), (1e-5, 1e-6)];
 
 /// Maximises `λ ≤ LAMBDA_CAP` (clarabel), trying [`SETTINGS`] from index
-/// `first` on before giving up (NaN).
-fn maximise(mut prog: Program, first: usize) -> (LimitResult, Option<Vec<f64>>) {
+/// `first` on before giving up (NaN). Returns the forces and, for the
+/// [`Mechanism`], each capacity row's dissipated work (its capacity times
+/// its dual).
+fn maximise(mut prog: Program, first: usize) -> (LimitResult, Option<Vec<f64>>, Option<Vec<f64>>) {
     let lam = prog.lam;
     let ncol = lam + 1;
+    let capacity = prog.n_eq..prog.rhs.len();
     prog.row(&[(lam, 1.0)], LAMBDA_CAP);
     let n_nonneg = prog.rhs.len() - prog.n_eq;
     // Second-order cones: s = (z, t_u, t_v) = −A x.
@@ -624,6 +712,7 @@ fn maximise(mut prog: Program, first: usize) -> (LimitResult, Option<Vec<f64>>) 
     let mut tries = 0;
     let mut setting = SETTINGS.len();
     let mut x = None;
+    let mut work = None;
     for (k, &(regularisation, tolerance)) in SETTINGS.iter().enumerate().skip(first) {
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
@@ -647,6 +736,7 @@ fn maximise(mut prog: Program, first: usize) -> (LimitResult, Option<Vec<f64>>) 
         ) {
             lambda = sol.x[lam].clamp(0.0, LAMBDA_CAP);
             x = Some(sol.x[..lam].to_vec());
+            work = Some(capacity.clone().map(|r| prog.rhs[r] * sol.z[r]).collect());
             setting = k;
             break;
         }
@@ -658,7 +748,7 @@ fn maximise(mut prog: Program, first: usize) -> (LimitResult, Option<Vec<f64>>) 
         setting,
         solver_lambda: lambda,
     };
-    (r, x)
+    (r, x, work)
 }
 
 /// A lower bound of the load factor of `part` under `loads`, which differ
@@ -905,7 +995,9 @@ mod tests {
             links: &links,
         };
         let base = gravity(s);
-        let (r, field) = load_factor_with_field(s, model, &base, part, Connectors::Capacities, 0);
+        let Solved {
+            result: r, field, ..
+        } = solve_with_capacities(s, model, &base, part, 0, true);
         let field = field.expect("an equilibrium");
         assert!(r.lambda > 1.0 && r.lambda < LAMBDA_CAP, "{}", r.lambda);
         let mut tight = 0;
@@ -1139,7 +1231,7 @@ mod tests {
             links: &links,
         };
         let base = gravity(&s);
-        let (_, field) = load_factor_with_field(&s, &model, &base, part, Connectors::Capacities, 0);
+        let field = solve_with_capacities(&s, &model, &base, part, 0, true).field;
         let field = field.unwrap();
         let tip = s
             .bodies

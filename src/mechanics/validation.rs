@@ -1580,3 +1580,117 @@ fn a_failing_sweep_is_refused_after_its_worst_pose_alone() {
     assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
     assert!(a.load_factor.unwrap() >= every * (1.0 - 1e-5));
 }
+
+/// A stepped tower resting on the ground (nothing fixed, no adhesion
+/// there) and an arm of `n` modules held by one connector at its top, the
+/// arm along −x, or along +x in the mirror image (`x ↦ −x`). Returns the
+/// cells and the index of the top module (the arm's are the last `n`).
+fn tower_with_arm(n: i32, mirror: bool) -> (Vec<Cell>, usize) {
+    // Centres: (x + ½p, y + ½p) with p the layer's parity; the mirror
+    // maps an even layer's x to −x and an odd layer's to −x − 1.
+    let m = |x: i32, y: i32, z: i32| {
+        let x = if !mirror {
+            x
+        } else if z % 2 == 0 {
+            -x
+        } else {
+            -x - 1
+        };
+        Cell::new(x, y, z)
+    };
+    let mut cells = Vec::new();
+    for x in 0..4 {
+        for y in 0..4 {
+            cells.push(m(x, y, 0));
+        }
+    }
+    for x in 0..3 {
+        for y in 0..3 {
+            cells.push(m(x, y, 1));
+        }
+    }
+    for (x, y) in [(2, 1), (3, 1), (2, 2), (3, 2)] {
+        cells.push(m(x, y, 2));
+    }
+    // The top, over the layer-2 cells at centres x = 2 only: the arm's
+    // first module (centre x = ½) has nothing below it.
+    let top = cells.len();
+    cells.push(m(1, 1, 3));
+    for i in 1..=n {
+        cells.push(m(1 - i, 1, 3));
+    }
+    (cells, top)
+}
+
+/// Where a structure resting on the ground fails by the limit analysis,
+/// the critical link is where its collapse mechanism opens, checked
+/// against the upper-bound theorem computed here by hand: the arm turns
+/// as one body about the horizontal line through the lowest corner(s) of
+/// its root square; each corner pulls `pL²/4` (rigid hinge) over the
+/// opening its height above that line gives, against the arm's weight
+/// times its lever. The limit analysis's factor (a lower bound) must equal
+/// it (to 10⁻¹³ as measured) and its mechanism must put the whole
+/// dissipated work at the root, in the tower as built and in its mirror
+/// image. (The arm is determinate, so the elastic estimate peaks at the
+/// root too, at utilisation 2; the mechanism is what names it where the
+/// screen left no estimate, as in the 20-meta-module RePoSt L → C's step
+/// 159, `docs/mechanics.md`.)
+#[test]
+fn a_resting_tower_whose_arm_breaks_names_the_root_its_collapse_mechanism_opens() {
+    use super::analysis::Critical;
+    for mirror in [false, true] {
+        let n = 3;
+        let (cells, top) = tower_with_arm(n, mirror);
+        let ground = Some(Ground { layer: 0 });
+        let s = structure(&FccLattice, ground, &cells, &[], &[]);
+        // The premise: the arm's root module is held by the top alone, and
+        // nothing is fixed.
+        let first = top + 1;
+        let (top_id, first_id) = (top as ModuleId + 1, first as ModuleId + 1);
+        let root = link_between(&s, top_id, first_id);
+        let at_first = s
+            .links
+            .iter()
+            .filter(|l| {
+                let b = s.body_of(first_id).unwrap();
+                l.a == b || l.b == super::structure::End::Body(b)
+            })
+            .count();
+        assert_eq!(at_first, 2, "the root and the next arm module");
+        assert!(s.bodies.iter().all(|b| !b.fixed));
+        // The upper bound by hand, at a pressure that makes it 1/2.
+        let base = Model::default_catom().with_connector(1.0, Bending::RigidHinge);
+        let (w, d) = (base.weight(), base.spacing);
+        let side = base.connector.side;
+        let l = &s.links[root];
+        let h = 0.5 * side / d;
+        let z: Vec<f64> = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+            .iter()
+            .map(|(a, b)| (l.contact + h * (a * l.u + b * l.v)).z)
+            .collect();
+        let z_min = z.iter().copied().fold(f64::INFINITY, f64::min);
+        let openings: f64 = z.iter().map(|zk| (zk - z_min) * d).sum();
+        let x_hinge = l.contact.x;
+        let lever: f64 = (0..n as usize)
+            .map(|i| (FccLattice.centre(cells[first + i]).x - x_hinge).abs() * d)
+            .sum();
+        // λ = p·(L²/4)·Σ openings / (W·Σ levers) = 1/2.
+        let pressure = 0.5 * w * lever / (side * side / 4.0 * openings);
+        let model = base.with_connector(pressure, Bending::RigidHinge);
+        let a = tight(model).analyse(&s);
+        assert_eq!(a.verdict(), Verdict::Overloaded, "mirror {mirror}");
+        let lf = a.load_factor.expect("the limit analysis judged it");
+        assert!(
+            (lf - 0.5).abs() <= 1e-5,
+            "mirror {mirror}: λ = {lf} against 0.5"
+        );
+        assert_eq!(a.critical, Some(Critical::Link(root)), "mirror {mirror}");
+        let m = a
+            .mechanism
+            .expect("a failing limit analysis has a mechanism");
+        assert_eq!(m.links[0].0, root);
+        assert!(m.links[0].1 >= 0.999, "mirror {mirror}: {:?}", m.links);
+        let total: f64 = m.links.iter().map(|x| x.1).sum();
+        assert!((0.999..=1.0 + 1e-9).contains(&total), "{total}");
+    }
+}

@@ -184,7 +184,7 @@ mod tests {
         let (prog, _) = program(s, model, &gravity(s), part, false).expect("a program");
         let mut with_reserve = prog.clone();
         reserve_pressure(&mut with_reserve);
-        let (r, x) = maximise(with_reserve, 0);
+        let (r, x, _) = maximise(with_reserve, 0);
         (prog, x.expect("solved"), r.lambda)
     }
 
