@@ -148,6 +148,12 @@ impl LoadCheck {
     }
 }
 
+/// How far outside its support polygon (in units of `d`) a component's
+/// weight must act for an `unstable` violation to say that it tips: below
+/// it, the rigid failure is not told by the weight's position (a failed
+/// solve, or a weight on the hull's edge).
+const TIPPING_TOL: f64 = 1e-9;
+
 /// The links of a collapse mechanism a violation lists, largest share
 /// first (the count of all of them is a detail of its own).
 const MECHANISM_LISTED: usize = 10;
@@ -340,7 +346,34 @@ fn report(step: usize, s: &Structure, a: &Analysis, out: &mut StepOutcome) {
                     loose.len()
                 )
             };
-            let mut v = critical_violation(ViolationKind::Unstable, step, &limit(&what), s, a);
+            // Tipping: the weight passes outside the support polygon. The
+            // witness replaces the critical element, which the rigid
+            // failure does not involve (a mover's hold, say).
+            let tipping = a.tipping.as_ref().filter(|t| t.outside > TIPPING_TOL);
+            let mut v = match tipping {
+                Some(t) => {
+                    let p = t.weight_at_ground;
+                    Violation::new(
+                        ViolationKind::Unstable,
+                        step,
+                        limit(&format!(
+                            "no static equilibrium: {} module(s) tip over: their weight acts at \
+                             ({:.2}, {:.2}, {:.2}) d at ground level, {:.3} d outside the convex \
+                             hull of their {} ground contact(s)",
+                            loose.len(),
+                            p.x,
+                            p.y,
+                            p.z,
+                            t.outside,
+                            t.contacts
+                        )),
+                    )
+                    .detail("weight_at_ground", [p.x, p.y, p.z])
+                    .detail("outside_support_d", t.outside)
+                    .detail("ground_contacts", t.contacts)
+                }
+                None => critical_violation(ViolationKind::Unstable, step, &limit(&what), s, a),
+            };
             v.modules.extend(loose.iter().take(50));
             out.violations
                 .push(v.detail("unsupported_modules", loose.len()));

@@ -159,6 +159,9 @@ pub struct Analysis {
     /// collapse mechanism at the pose of its smallest factor (links of
     /// `Structure::links` with their shares of the dissipated work).
     pub mechanism: Option<limit::Mechanism>,
+    /// Where a component falls even on rigid connectors (the one with the
+    /// smallest rigid factor): its weight against its ground contacts.
+    pub tipping: Option<super::tipping::Tipping>,
     pub verdict: Option<Verdict>,
     /// CG iterations (preconditioned by a kept factor, or refining a fresh
     /// one) and sparse factorisations this analysis took.
@@ -301,6 +304,9 @@ struct LimitOutcome {
     /// The collapse mechanism of the solved pose with the smallest factor,
     /// where that factor fails (below 1) and the solve gives one.
     mechanism: Option<limit::Mechanism>,
+    /// Where `rigid` fails: the weight against the ground contacts at the
+    /// pose of the smallest rigid factor.
+    tipping: Option<super::tipping::Tipping>,
 }
 
 /// Solver settings.
@@ -1821,6 +1827,7 @@ impl Analyzer {
             lower: 1.0 / bound,
             setting: self.limit_setting,
             mechanism: None,
+            tipping: None,
         }
     }
 
@@ -1851,6 +1858,7 @@ impl Analyzer {
             lower: f64::INFINITY,
             setting: self.limit_setting,
             mechanism: None,
+            tipping: None,
         };
         let part = limit::Part {
             bodies: &comps.bodies[c],
@@ -2030,12 +2038,23 @@ impl Analyzer {
         out: &mut LimitOutcome,
     ) {
         if fails(out.capacities) {
+            let mut worst: Option<(f64, Option<usize>)> = None;
             for &(pose, _) in failing {
                 let loads = body_loads(s, pose);
                 let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
                 // (Held by a fixed module, the rigid case needs no solve.)
                 out.runs += usize::from(rigid.iterations > 0);
                 out.rigid = lowest(out.rigid, rigid.lambda);
+                if worst.is_none_or(|(lf, _)| rigid.lambda < lf) {
+                    worst = Some((rigid.lambda, pose));
+                }
+            }
+            if fails(out.rigid)
+                && let Some((_, pose)) = worst
+            {
+                let loads = body_loads(s, pose);
+                out.tipping =
+                    super::tipping::tipping(s, &self.model, &loads, part.bodies, part.links);
             }
         }
     }
@@ -2276,6 +2295,7 @@ impl Analyzer {
             }
         }
         let mut no_equilibrium = !out.unsupported.is_empty();
+        let mut smallest_rigid = f64::INFINITY;
         for (c, l) in limits {
             // The smallest factor; a failed solve (NaN) sticks.
             let lf = l.capacities;
@@ -2287,6 +2307,10 @@ impl Analyzer {
                 // It tips or slides: no equilibrium to take a utilisation
                 // of (as for a floating part), whatever 1/λ's round-off.
                 no_equilibrium = true;
+                if out.tipping.is_none() || l.rigid < smallest_rigid {
+                    smallest_rigid = l.rigid;
+                    out.tipping = l.tipping.clone();
+                }
                 continue;
             }
             // At a failing pose the component's utilisation is 1/λ: the

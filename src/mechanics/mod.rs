@@ -20,6 +20,8 @@
 //!   along the movers' path, bounding runs of poses by one triangle each.
 //! * `superposition` — a step's poses as a few unit load cases: at most
 //!   three per group of movers turning at one rate, however many movers.
+//! * `tipping` — where a component that falls even on rigid connectors has
+//!   its weight, against the convex hull of its ground contacts.
 //!
 //! See `docs/mechanics.md` for the derivations and the choice of model.
 
@@ -36,6 +38,7 @@ pub(crate) mod solver;
 pub(crate) mod structure;
 pub(crate) mod superposition;
 pub(crate) mod sweep_bisection;
+pub(crate) mod tipping;
 
 pub use analysis::{Analysis, Analyzer, Critical, LinkResult, Verdict};
 pub use capacity::{ConnectorLoad, Mode, overloaded, severity, utilisation};

@@ -228,7 +228,7 @@ fn inside(t: [[f64; 2]; 3], p: [f64; 2], tol: f64) -> bool {
 
 /// The convex hull, counter-clockwise (Andrew's monotone chain), points
 /// closer than `tol` to an edge dropped.
-fn convex_hull(points: &[[f64; 2]], tol: f64) -> Vec<[f64; 2]> {
+pub(super) fn convex_hull(points: &[[f64; 2]], tol: f64) -> Vec<[f64; 2]> {
     let mut p = points.to_vec();
     p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
     p.dedup_by(|a, b| norm(sub(*a, *b)) <= tol);

@@ -1694,3 +1694,58 @@ fn a_resting_tower_whose_arm_breaks_names_the_root_its_collapse_mechanism_opens(
         assert!((0.999..=1.0 + 1e-9).contains(&total), "{total}");
     }
 }
+
+/// Where a structure resting on the ground falls as a whole, the witness
+/// is its weight against its support polygon, checked by hand: with equal
+/// modules and nothing moving, the weight acts at the mean of the module
+/// centres, which a long arm carries past the slab's edge; the distance
+/// outside is that mean's x against the outermost ground-contact corner
+/// (the slab's edge is parallel to y and the mean lies at its middle, y =
+/// 1.5). Connectors too strong to break, so only the balance fails — as
+/// built and mirrored. (With 12 arm modules the mean lies at x = −0.26,
+/// past the slab's centres but over its lower faces' squares, which reach
+/// further out: the tower stands, as it must.)
+#[test]
+fn a_resting_tower_tipped_by_its_arm_reports_its_weight_outside_its_ground_contacts() {
+    let strong = Model::default_catom().with_connector(1e9, Bending::RigidHinge);
+    let (cells, _) = tower_with_arm(12, false);
+    let s = structure(&FccLattice, Some(Ground { layer: 0 }), &cells, &[], &[]);
+    let a = tight(strong).analyse(&s);
+    assert_eq!(a.verdict(), Verdict::Stable, "12 arm modules: it stands");
+    assert!(a.tipping.is_none());
+    for mirror in [false, true] {
+        let (cells, _) = tower_with_arm(13, mirror);
+        let ground = Some(Ground { layer: 0 });
+        let s = structure(&FccLattice, ground, &cells, &[], &[]);
+        let model = Model::default_catom().with_connector(1e9, Bending::RigidHinge);
+        let half = 0.5 * model.ground.side / model.spacing;
+        let a = tight(model).analyse(&s);
+        assert_eq!(a.verdict(), Verdict::NoEquilibrium, "mirror {mirror}");
+        let n = cells.len() as f64;
+        let mean = cells.iter().map(|&c| FccLattice.centre(c)).sum::<DVec3>() / n;
+        // The outermost corner of the ground contacts on the arm's side.
+        let corners = s.links.iter().filter(|l| l.is_ground()).flat_map(|l| {
+            [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+                .map(|(p, q)| (l.contact + half * (p * l.u + q * l.v)).x)
+        });
+        let expected = if mirror {
+            mean.x - corners.fold(f64::NEG_INFINITY, f64::max)
+        } else {
+            corners.fold(f64::INFINITY, f64::min) - mean.x
+        };
+        assert!(
+            expected > 0.05,
+            "the premise: the weight is outside ({expected})"
+        );
+        let t = a.tipping.expect("a tipping witness");
+        assert!(
+            (t.outside - expected).abs() < 1e-9,
+            "mirror {mirror}: {} against {expected}",
+            t.outside
+        );
+        assert!((t.weight_at_ground.x - mean.x).abs() < 1e-9);
+        assert!((t.weight_at_ground.y - 1.5).abs() < 1e-9);
+        // The four lower faces of each of the slab's 16 modules.
+        assert_eq!(t.contacts, 64);
+    }
+}
