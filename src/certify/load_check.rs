@@ -751,6 +751,63 @@ mod tests {
         }
     }
 
+    /// A column of three catoms leaning one half-cell per layer, resting
+    /// on one ground module: its weight (mean centre x = y = ½ d) lies past
+    /// the base's lower faces (a quarter cell and half a square side out).
+    fn leaning_column(mirror: bool) -> Schedule {
+        let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+        s.ground = Some(crate::lattice::config::Ground { layer: 0 });
+        let cells = if mirror {
+            [(0, 0, 0), (-1, -1, 1), (-1, -1, 2)]
+        } else {
+            [(0, 0, 0), (0, 0, 1), (1, 1, 2)]
+        };
+        for (i, (x, y, z)) in cells.into_iter().enumerate() {
+            s.modules.push(ModuleSpec {
+                id: i as u32 + 1,
+                cell: Cell::new(x, y, z),
+                fixed: false,
+            });
+        }
+        s
+    }
+
+    #[test]
+    fn a_leaning_column_tips_over_on_the_ground_and_stands_on_a_latched_base() {
+        for mirror in [false, true] {
+            let col = leaning_column(mirror);
+            let r = certify(&col, &opts(Some("catom-3.6mm.toml"))).unwrap();
+            let v: Vec<_> = r
+                .violations
+                .iter()
+                .filter(|v| v.kind == ViolationKind::Unstable)
+                .collect();
+            assert_eq!(v.len(), 1, "the final configuration: {}", r.summary());
+            assert!(
+                v[0].message.contains("3 module(s) tip over"),
+                "{}",
+                v[0].message
+            );
+            assert!(
+                v[0].message
+                    .contains("outside the convex hull of their 4 ground contact(s)")
+            );
+            // The weight acts at the mean centre, (½, ½) d from the base's
+            // centre (mirrored: (−½, −½)); the lower faces' squares reach
+            // less than half a cell out, so it is outside by a margin.
+            let at = &v[0].detail["weight_at_ground"];
+            let sign = if mirror { -1.0 } else { 1.0 };
+            for k in 0..2 {
+                let x = at[k].as_f64().unwrap();
+                assert!((x - sign * 0.5).abs() < 1e-9, "{at}");
+            }
+            let out = v[0].detail["outside_support_d"].as_f64().unwrap();
+            assert!(out > 0.05 && out < 0.5, "{out}");
+            let latched = certify(&col, &opts(Some("catom-3.6mm-latched-base.toml"))).unwrap();
+            assert!(latched.certified, "{}", latched.summary());
+        }
+    }
+
     #[test]
     fn a_short_branch_extended_by_an_agent_is_certified_with_its_utilisation() {
         let r = certify(&branch_schedule(3), &opts(Some("catom-3.6mm.toml"))).unwrap();
