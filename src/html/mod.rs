@@ -97,7 +97,8 @@ pub struct Finding {
     pub modules: Vec<u32>,
     /// Centres of the cells it names (units of d).
     pub cells: Vec<[f64; 3]>,
-    /// Witness points (collision checks: on the mover and on the other).
+    /// Witness points (collision checks: on the mover and on the other;
+    /// a structure that tips: where its weight acts at ground level).
     pub witness: Vec<[f64; 3]>,
 }
 
@@ -115,7 +116,7 @@ pub struct Scene {
 
 fn finding(v: &Violation, lattice: LatticeKind) -> Finding {
     let centre = |c: &Cell| lattice.lattice().centre(*c).to_array();
-    let witness = ["witness_mover", "witness_other"]
+    let witness = ["witness_mover", "witness_other", "weight_at_ground"]
         .iter()
         .filter_map(|k| v.detail.get(*k))
         .filter_map(|w| serde_json::from_value::<[f64; 3]>(w.clone()).ok())

@@ -125,6 +125,44 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
 /// that were checked, every one of them when the budget allows, and no
 /// other (not the final configuration, which was not reached).
 #[test]
+fn a_structure_that_tips_over_shows_where_its_weight_acts() {
+    // Three catoms leaning half a cell per layer on one resting module.
+    let mut s = Schedule::new(LatticeKind::Fcc, crate::schedule::Length::mm(3.6));
+    s.ground = Some(crate::lattice::config::Ground { layer: 0 });
+    for (i, (x, y, z)) in [(0, 0, 0), (0, 0, 1), (1, 1, 2)].into_iter().enumerate() {
+        s.modules.push(crate::schedule::ModuleSpec {
+            id: i as u32 + 1,
+            cell: Cell::new(x, y, z),
+            fixed: false,
+        });
+    }
+    let (path, _) = shipped_model();
+    let o = Options {
+        model: Some(path),
+        ..Default::default()
+    };
+    let report = certify::certify(&s, &o).unwrap();
+    let html = Page {
+        title: "leaning".into(),
+        report: Some(&report),
+        schedule: Some(&s),
+        ..Default::default()
+    }
+    .html();
+    let data = inlined(&html);
+    let shown = data["violations"].as_array().unwrap();
+    let tips: Vec<_> = shown.iter().filter(|p| p["kind"] == "unstable").collect();
+    assert_eq!(tips.len(), 1, "{}", report.summary());
+    let w: Vec<[f64; 3]> = serde_json::from_value(tips[0]["witness"].clone()).unwrap();
+    assert_eq!(w.len(), 1);
+    // The mean of the centres (0, 0), (½, ½), (1, 1), at ground level.
+    assert!(
+        (w[0][0] - 0.5).abs() < 1e-9 && (w[0][1] - 0.5).abs() < 1e-9,
+        "{w:?}"
+    );
+}
+
+#[test]
 fn a_span_of_steps_has_load_maps_of_its_steps_only() {
     let s = scaffold();
     let (path, model) = shipped_model();

@@ -184,7 +184,7 @@ pub fn solve_with_capacities(
     first: usize,
     keep_field: bool,
 ) -> Solved {
-    let (result, field, mechanism) = solve_full(
+    let (result, field, mechanism) = solve(
         s,
         model,
         loads,
@@ -344,19 +344,6 @@ fn equation_groups(s: &Structure, part: Part<'_>, rigid: bool) -> (Vec<usize>, u
 }
 
 fn solve(
-    s: &Structure,
-    model: &Model,
-    loads: &[Vec6],
-    part: Part<'_>,
-    which: Connectors,
-    keep_field: bool,
-    first: usize,
-) -> (LimitResult, Option<Field>) {
-    let (r, field, _) = solve_full(s, model, loads, part, which, keep_field, first);
-    (r, field)
-}
-
-fn solve_full(
     s: &Structure,
     model: &Model,
     loads: &[Vec6],
