@@ -43,6 +43,19 @@ fn inlined(html: &str) -> serde_json::Value {
     serde_json::from_str(&html[start..end].replace("<\\/", "</")).unwrap()
 }
 
+/// The data inlined in the page of `report` on `schedule`.
+fn page_data(title: &str, report: &certify::Report, schedule: &Schedule) -> serde_json::Value {
+    inlined(
+        &Page {
+            title: title.into(),
+            report: Some(report),
+            schedule: Some(schedule),
+            ..Default::default()
+        }
+        .html(),
+    )
+}
+
 #[test]
 fn the_inlined_replay_gives_the_schedules_configuration_at_every_step() {
     let s = scaffold();
@@ -85,14 +98,7 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
         .filter(|v| v.kind == crate::certify::ViolationKind::Collision)
         .collect();
     assert!(!collisions.is_empty(), "the obstacle is cut");
-    let html = Page {
-        title: "walk".into(),
-        report: Some(&report),
-        schedule: Some(&s),
-        ..Default::default()
-    }
-    .html();
-    let data = inlined(&html);
+    let data = page_data("walk", &report, &s);
     let shown = data["violations"].as_array().unwrap();
     assert_eq!(shown.len(), report.violations.len());
     for (v, p) in report.violations.iter().zip(shown) {
@@ -142,14 +148,7 @@ fn a_structure_that_tips_over_shows_where_its_weight_acts() {
         ..Default::default()
     };
     let report = certify::certify(&s, &o).unwrap();
-    let html = Page {
-        title: "leaning".into(),
-        report: Some(&report),
-        schedule: Some(&s),
-        ..Default::default()
-    }
-    .html();
-    let data = inlined(&html);
+    let data = page_data("leaning", &report, &s);
     let shown = data["violations"].as_array().unwrap();
     let tips: Vec<_> = shown.iter().filter(|p| p["kind"] == "unstable").collect();
     assert_eq!(tips.len(), 1, "{}", report.summary());
