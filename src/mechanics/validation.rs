@@ -835,6 +835,16 @@ fn a_bisected_sweep_reports_every_poses_smallest_factor_from_fewer_analyses() {
     let lower = a.load_factor_lower.or(a.load_factor).unwrap();
     assert!(lower <= every * (1.0 + 1e-5), "{lower} against {every}");
     assert!(a.load_factor.unwrap() < 1.0);
+    // Where it gives way does not depend on how the poses were searched:
+    // the collapse mechanism names the same connector, which is the
+    // critical one.
+    let (m, m_full) = (a.mechanism.unwrap(), full.mechanism.unwrap());
+    assert_eq!(m.links[0].0, m_full.links[0].0);
+    assert!(m.links[0].1 > 0.5, "{:?}", m.links);
+    assert_eq!(
+        a.critical,
+        Some(super::analysis::Critical::Link(m.links[0].0))
+    );
 }
 
 /// [`wall_swing`]'s wall with a mover onto its top at each end, turning
@@ -1526,7 +1536,11 @@ fn a_crowd_failing_only_between_its_samples_is_refused() {
     // sqrt(samples / between) > 1 and the tangent poses' its inverse.
     let mut model = base.clone();
     model.connector.pressure *= 1.0 / (samples * between).sqrt();
-    let (samples, between) = (smallest(&model, 0..n), smallest(&model, n..m));
+    let at_between: Vec<f64> = (n..m)
+        .map(|k| factor_at_pose(&model, &s, k).unwrap_or(f64::INFINITY))
+        .collect();
+    let samples = smallest(&model, 0..n);
+    let between = at_between.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(samples > 1.0 && between < 1.0, "{samples} {between}");
     let alone = Analyzer::new(model.clone(), false);
     let mut alone = alone;
@@ -1539,6 +1553,29 @@ fn a_crowd_failing_only_between_its_samples_is_refused() {
     assert!(
         (lambda - between).abs() <= 1e-5 * between,
         "{lambda} against {between}"
+    );
+    // The bisection keeps factors only; the failing pose it found is
+    // solved again for its collapse mechanism, which names the connector
+    // the worst pose analysed alone names.
+    let worst = n
+        + (0..at_between.len())
+            .min_by(|&i, &j| at_between[i].total_cmp(&at_between[j]))
+            .unwrap();
+    let mut one = s.clone();
+    for h in 0..one.hanging.len() {
+        one.hanging[h].path = vec![s.mover_point(h, worst)];
+        one.hanging[h].hull.clear();
+    }
+    one.between.clear();
+    let alone = Analyzer::new(model.clone(), false).analyse(&one);
+    let (m_b, m_alone) = (b.mechanism.unwrap(), alone.mechanism.unwrap());
+    assert_eq!(
+        m_b.links[0].0, m_alone.links[0].0,
+        "{m_b:?} against {m_alone:?}"
+    );
+    assert_eq!(
+        b.critical,
+        Some(super::analysis::Critical::Link(m_b.links[0].0))
     );
 }
 
