@@ -654,3 +654,68 @@ fn the_papers_goal_order_fills_cells_above_empty_ones_and_needs_fewer_iterations
     );
     assert_eq!(e.file.as_deref(), Some(base.path.as_path()));
 }
+
+/// The porous structure's joints, counted from the lattice's neighbours:
+/// two SPARSE meta-modules side by side (along X or Y) touch through
+/// exactly one catom–catom connector, one above the other through four.
+/// So a meta-module held only by a side neighbour hangs on one connector:
+/// under the default model (100 kPa) it holds along X and not along Y,
+/// where the collapse mechanism is that one connector at load factor
+/// 0.939 — the overloads of the 28-meta-module L → C (`docs/repost.md`).
+#[test]
+fn a_sparse_meta_module_hangs_on_one_connector_from_a_side_neighbour_and_breaks_it_along_y() {
+    use reconfcheck::algorithms::repost::metamodule::Meta;
+    use reconfcheck::certify::ViolationKind;
+    use reconfcheck::lattice::{FccLattice, Lattice, LatticeKind};
+    use reconfcheck::schedule::{Length, ModuleSpec, Schedule};
+    let joints = |a: Meta, b: Meta| {
+        let other: Vec<Cell> = b.sparse_cells().to_vec();
+        a.sparse_cells()
+            .iter()
+            .flat_map(|&c| FccLattice.neighbours(c))
+            .filter(|n| other.contains(n))
+            .count()
+    };
+    for m in [Meta::new(0, 0, 0), Meta::new(1, 0, 1), Meta::new(0, 1, 0)] {
+        for (d, n) in [((1, 0, 0), 1), ((0, 1, 0), 1), ((0, 0, 1), 4)] {
+            let next = Meta::new(m.x + d.0, m.y + d.1, m.z + d.2);
+            assert_eq!(joints(m, next), n, "{m:?} to {next:?}");
+        }
+    }
+    let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");
+    let hanging = |side: Meta| {
+        let mut s = Schedule::new(LatticeKind::Fcc, Length::mm(3.6));
+        let cells = Meta::new(0, 0, 0)
+            .sparse_cells()
+            .into_iter()
+            .map(|c| (c, true));
+        let free = side.sparse_cells().into_iter().map(|c| (c, false));
+        for (i, (cell, fixed)) in cells.chain(free).enumerate() {
+            s.modules.push(ModuleSpec {
+                id: i as u32 + 1,
+                cell,
+                fixed,
+            });
+        }
+        let o = Options {
+            model: Some(model.clone()),
+            ..Default::default()
+        };
+        certify(&s, &o).unwrap()
+    };
+    assert!(hanging(Meta::new(1, 0, 0)).certified, "along X it holds");
+    let r = hanging(Meta::new(0, 1, 0));
+    let v: Vec<_> = r
+        .violations
+        .iter()
+        .filter(|v| v.kind == ViolationKind::Overload)
+        .collect();
+    assert_eq!(v.len(), 1, "{}", r.summary());
+    let lf = v[0].detail["load_factor"].as_f64().unwrap();
+    assert!((lf - 0.939).abs() < 1e-3, "{lf}");
+    assert!(v[0].detail["share"].as_f64().unwrap() > 0.999);
+    // The connector named joins the fixed meta-module (ids 1-10) to the
+    // hanging one (11-20).
+    let ids = &v[0].modules;
+    assert!(ids.len() == 2 && ids.iter().any(|&i| i <= 10) && ids.iter().any(|&i| i > 10));
+}
