@@ -394,6 +394,10 @@ fn solve(
 /// finite.
 fn mechanism(links: &[usize], work: &[f64]) -> Option<Mechanism> {
     debug_assert_eq!(work.len(), CAPACITY_ROWS * links.len());
+    // A NaN must not be read as no work (`f64::max` would drop it).
+    if work.iter().any(|w| !w.is_finite()) {
+        return None;
+    }
     let per_link: Vec<f64> = work
         .chunks(CAPACITY_ROWS)
         .map(|rows| rows.iter().map(|w| w.max(0.0)).sum())
@@ -954,6 +958,21 @@ mod tests {
     use crate::lattice::{Cell, FccLattice};
     use crate::mechanics::validation::{frame, structure};
     use glam::DVec3;
+
+    /// A mechanism's shares come from the work of every capacity row: a
+    /// NaN among them gives no mechanism (never a share read as 0), and
+    /// the shares of finite works sum to 1, largest first.
+    #[test]
+    fn a_mechanism_shares_finite_work_and_refuses_a_nan() {
+        let mut work = vec![0.0; 2 * CAPACITY_ROWS];
+        work[1] = 1.0;
+        work[CAPACITY_ROWS + 3] = 3.0;
+        let m = mechanism(&[7, 9], &work).unwrap();
+        assert_eq!(m.links, vec![(9, 0.75), (7, 0.25)]);
+        work[2] = f64::NAN;
+        assert_eq!(mechanism(&[7, 9], &work), None);
+        assert_eq!(mechanism(&[7, 9], &[0.0; 2 * CAPACITY_ROWS]), None);
+    }
 
     /// Every body and every link of `s`: the part that is the whole.
     fn everything(s: &Structure) -> (Vec<usize>, Vec<usize>) {

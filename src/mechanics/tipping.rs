@@ -49,7 +49,11 @@ pub fn tipping(
     }
     let down = force / weight;
     // The point of the line of action nearest the origin: F × M / |F|².
+    // A NaN moment gives no witness (never a distance that compares false).
     let on_line = force.cross(moment) / (weight * weight);
+    if !on_line.is_finite() {
+        return None;
+    }
     let half = 0.5 * model.capacity_of(true).side / model.spacing;
     let corners: Vec<DVec3> = links
         .iter()
@@ -110,6 +114,12 @@ fn outside(hull: &[[f64; 2]], p: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::outside;
+
+    #[test]
+    fn a_point_that_is_not_finite_is_never_read_as_inside() {
+        let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        assert_ne!(outside(&sq, [f64::NAN, 0.5]), 0.0);
+    }
 
     #[test]
     fn a_point_inside_a_square_is_zero_outside_and_one_beyond_an_edge_is_its_distance() {
