@@ -307,6 +307,11 @@ fn an_overhang_tips_without_ground_adhesion_and_holds_with_it() {
     let b = tight(square_model(0.0)).analyse(&long);
     assert_eq!(b.verdict(), Verdict::NoEquilibrium);
     assert_eq!(b.unsupported.len(), 4);
+    // The tipping witness (gravity along −y here): the weight at x = ¾,
+    // a quarter cell outside the contact.
+    let t = b.tipping.as_ref().expect("a tipping witness");
+    assert!((t.outside - 0.25).abs() < 1e-12, "{t:?}");
+    assert!((t.weight_at_ground.x - 0.75).abs() < 1e-12, "{t:?}");
     // With the ground latched (adhesion), the same overhang holds.
     let c = tight(square_model(20.0)).analyse(&long);
     assert_eq!(c.verdict(), Verdict::Stable);
@@ -336,6 +341,9 @@ fn a_structure_on_two_feet_tips_when_its_centre_of_mass_leaves_the_base() {
     let b = tight(square_model(0.0)).analyse(&s2);
     assert_eq!(b.verdict(), Verdict::NoEquilibrium);
     assert_eq!(b.unsupported.len(), 10);
+    let t = b.tipping.as_ref().expect("a tipping witness");
+    assert!((t.outside - 0.5).abs() < 1e-12, "{t:?}");
+    assert_eq!(t.contacts, 2);
     // Latched to the ground it holds.
     let c = tight(square_model(20.0)).analyse(&s2);
     assert_eq!(c.verdict(), Verdict::Stable);
