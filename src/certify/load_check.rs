@@ -188,71 +188,58 @@ pub fn critical_violation(
                 }
                 End::Ground(c) => cells.push(c),
             }
-            let share = a
-                .mechanism
-                .as_ref()
-                .and_then(|m| m.links.iter().find(|(li, _)| *li == i).map(|x| x.1));
-            match (share, &a.mechanism) {
-                // A limit-analysis failure: the elastic estimate's figures
-                // for this link are not what fails; the mechanism is.
-                (Some(share), Some(m)) => {
-                    let large = m.links.iter().filter(|x| x.1 >= 0.01).count();
-                    let listed: Vec<serde_json::Value> = m
-                        .links
-                        .iter()
-                        .take(MECHANISM_LISTED)
-                        .map(|&(li, share)| {
-                            serde_json::json!({
-                                "connector": s.describe(&s.links[li]),
-                                "share": share,
-                            })
+            // A limit-analysis failure names the link its collapse
+            // mechanism works hardest, with that link's share of the work.
+            let mechanism = a.mechanism.as_ref().and_then(|m| {
+                let share = m.links.iter().find(|(li, _)| *li == i)?.1;
+                Some((m, share))
+            });
+            let message = match mechanism {
+                Some((m, share)) => format!(
+                    "{what}: its collapse mechanism works the {} hardest \
+                     ({:.0} % of the work it dissipates; {} connector(s) take 1 % or more)",
+                    s.describe(l),
+                    100.0 * share,
+                    m.links.iter().filter(|x| x.1 >= 0.01).count()
+                ),
+                None => format!(
+                    "{what}: most loaded is the {} at utilisation {:.3} ({})",
+                    s.describe(l),
+                    r.utilisation,
+                    r.mode.map(|m| m.name()).unwrap_or("-")
+                ),
+            };
+            let mut v = Violation::new(kind, step, message)
+                .modules(modules)
+                .cells(cells)
+                .detail("connector", s.describe(l));
+            if let Some((m, share)) = mechanism {
+                let listed: Vec<serde_json::Value> = m
+                    .links
+                    .iter()
+                    .take(MECHANISM_LISTED)
+                    .map(|&(li, share)| {
+                        serde_json::json!({
+                            "connector": s.describe(&s.links[li]),
+                            "share": share,
                         })
-                        .collect();
-                    let v = Violation::new(
-                        kind,
-                        step,
-                        format!(
-                            "{what}: its collapse mechanism works the {} hardest \
-                             ({:.0} % of the work it dissipates; {} connector(s) take 1 % or more)",
-                            s.describe(l),
-                            100.0 * share,
-                            large
-                        ),
-                    )
-                    .modules(modules)
-                    .cells(cells)
-                    .detail("connector", s.describe(l))
+                    })
+                    .collect();
+                v = v
                     .detail("share", share)
                     .detail("mechanism", listed)
                     .detail("mechanism_connectors", m.links.len());
-                    // The elastic estimate's figures where it judged this
-                    // link (not where the screen left the component to the
-                    // limit analysis without a witness: zeros, not loads).
-                    if r.mode.is_some() {
-                        v.detail("utilisation", r.utilisation)
-                            .detail("mode", r.mode.map(|m| m.name()))
-                            .detail("load", r.load)
-                    } else {
-                        v
-                    }
-                }
-                _ => Violation::new(
-                    kind,
-                    step,
-                    format!(
-                        "{what}: most loaded is the {} at utilisation {:.3} ({})",
-                        s.describe(l),
-                        r.utilisation,
-                        r.mode.map(|m| m.name()).unwrap_or("-")
-                    ),
-                )
-                .modules(modules)
-                .cells(cells)
-                .detail("connector", s.describe(l))
-                .detail("utilisation", r.utilisation)
-                .detail("mode", r.mode.map(|m| m.name()))
-                .detail("load", r.load),
             }
+            // The elastic estimate's figures, except where the screen left
+            // the component to the limit analysis without a witness for
+            // this link (zeros, not loads).
+            if mechanism.is_none() || r.mode.is_some() {
+                v = v
+                    .detail("utilisation", r.utilisation)
+                    .detail("mode", r.mode.map(|m| m.name()))
+                    .detail("load", r.load);
+            }
+            v
         }
         Some(Critical::Pivot(i)) => {
             let p = &a.pivots[i];

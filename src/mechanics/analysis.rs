@@ -2038,21 +2038,21 @@ impl Analyzer {
         out: &mut LimitOutcome,
     ) {
         if fails(out.capacities) {
-            let mut worst: Option<(f64, Option<usize>)> = None;
+            // The loads of the pose with the smallest rigid factor.
+            let mut worst: Option<(f64, Vec<Vec6>)> = None;
             for &(pose, _) in failing {
                 let loads = body_loads(s, pose);
                 let rigid = limit::load_factor(s, &self.model, &loads, part, Connectors::Rigid);
                 // (Held by a fixed module, the rigid case needs no solve.)
                 out.runs += usize::from(rigid.iterations > 0);
                 out.rigid = lowest(out.rigid, rigid.lambda);
-                if worst.is_none_or(|(lf, _)| rigid.lambda < lf) {
-                    worst = Some((rigid.lambda, pose));
+                if worst.as_ref().is_none_or(|(lf, _)| rigid.lambda < *lf) {
+                    worst = Some((rigid.lambda, loads));
                 }
             }
             if fails(out.rigid)
-                && let Some((_, pose)) = worst
+                && let Some((_, loads)) = worst
             {
-                let loads = body_loads(s, pose);
                 out.tipping =
                     super::tipping::tipping(s, &self.model, &loads, part.bodies, part.links);
             }

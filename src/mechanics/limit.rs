@@ -546,13 +546,13 @@ fn capacity<'m>(s: &Structure, model: &'m Model, li: usize) -> &'m Capacity {
 }
 
 /// Half the side of link `li`'s contact square, in units of `d`.
-fn half_side(s: &Structure, model: &Model, li: usize) -> f64 {
+pub(super) fn half_side(s: &Structure, model: &Model, li: usize) -> f64 {
     0.5 * capacity(s, model, li).side / model.spacing
 }
 
 /// Each corner of link `l`'s square (half side `half`, in `d`): its first
 /// column within the link's and its position.
-fn corners(l: &Link, half: f64) -> impl Iterator<Item = (usize, glam::DVec3)> + '_ {
+pub(super) fn corners(l: &Link, half: f64) -> impl Iterator<Item = (usize, glam::DVec3)> + '_ {
     CORNERS
         .iter()
         .enumerate()

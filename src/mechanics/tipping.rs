@@ -6,6 +6,7 @@
 //! hull; so where the rigid limit analysis fails, the line passes outside
 //! it, and how far says how badly the structure is out of balance.
 
+use super::limit::{corners, half_side};
 use super::model::Model;
 use super::pose_hull::convex_hull;
 use super::solver::Vec6;
@@ -54,29 +55,25 @@ pub fn tipping(
     if !on_line.is_finite() {
         return None;
     }
-    let half = 0.5 * model.capacity_of(true).side / model.spacing;
-    let corners: Vec<DVec3> = links
+    // The squares' corners as the limit analysis places them.
+    let support: Vec<DVec3> = links
         .iter()
-        .map(|&li| &s.links[li])
-        .filter(|l| matches!(l.b, End::Ground(_)))
-        .flat_map(|l| {
-            [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
-                .map(|(a, b)| l.contact + half * (a * l.u + b * l.v))
-        })
+        .filter(|&&li| matches!(s.links[li].b, End::Ground(_)))
+        .flat_map(|&li| corners(&s.links[li], half_side(s, model, li)).map(|(_, c)| c))
         .collect();
-    if corners.is_empty() {
+    if support.is_empty() {
         return None;
     }
-    let level = corners.iter().map(|c| c.dot(down)).sum::<f64>() / corners.len() as f64;
+    let level = support.iter().map(|c| c.dot(down)).sum::<f64>() / support.len() as f64;
     let weight_at_ground = on_line + down * (level - on_line.dot(down));
     let (e1, e2) = down.any_orthonormal_pair();
     let plane = |p: DVec3| [p.dot(e1), p.dot(e2)];
-    let points: Vec<[f64; 2]> = corners.iter().map(|&c| plane(c)).collect();
+    let points: Vec<[f64; 2]> = support.iter().map(|&c| plane(c)).collect();
     let hull = convex_hull(&points, 1e-12);
     Some(Tipping {
         weight_at_ground,
         outside: outside(&hull, plane(weight_at_ground)),
-        contacts: corners.len() / 4,
+        contacts: support.len() / 4,
     })
 }
 
