@@ -655,6 +655,73 @@ fn the_papers_goal_order_fills_cells_above_empty_ones_and_needs_fewer_iterations
     assert_eq!(e.file.as_deref(), Some(base.path.as_path()));
 }
 
+/// `goal_order = "supported"` (ours, stricter): each empty goal cell is
+/// assembled from the SPARSE neighbour that holds it best, by the most
+/// connectors to it and then to the rest of the structure. The L → C-36's
+/// top arm in small: the goal cell (0, 1, 1) has two SPARSE neighbours,
+/// (1, 1, 1), which hangs on one side connector from (1, 0, 1), and
+/// (0, 0, 1), stacked on (0, 0, 0). The paper's rule takes the first in
+/// its order of directions, the hanging one; "supported" the stacked one.
+/// Both plans end on the goal and certify collision-free.
+#[test]
+fn the_supported_goal_order_assembles_a_cell_from_its_best_held_neighbour() {
+    use reconfcheck::algorithms::repost::metamodule::Meta;
+    let tag = "repost-supported";
+    // Leaders of (0,0,0) (1,0,0) (0,0,1) (1,0,1) (1,1,1), then the
+    // source (-1,0,0) or the goal cell (0,1,1).
+    let common_cells = "0 0 0\n4 0 0\n0 -1 4\n4 -1 4\n4 2 4\n";
+    std::fs::write(
+        common::scratch(tag, "i.txt"),
+        format!("{common_cells}-4 0 0\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        common::scratch(tag, "g.txt"),
+        format!("{common_cells}0 2 4\n"),
+    )
+    .unwrap();
+    let destination = |order: &str| {
+        let sc = common::scratch(tag, &format!("{order}.toml"));
+        std::fs::write(
+            &sc,
+            format!("name = \"{tag}\"\nalgorithm = \"repost\"\n[parameters]\ninitial = \"i.txt\"\ngoal = \"g.txt\"\ngoal_order = \"{order}\"\n"),
+        )
+        .unwrap();
+        let scenario = reconfcheck::scenario::Scenario::load(&sc).unwrap();
+        let s = reconfcheck::algorithms::generate(&scenario).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.meta["goal_order"], order);
+        ends_on(&s, &common::scratch(tag, "g.txt"));
+        certifies_collision_free(&s);
+        let its = s.meta["iteration_detail"].as_array().unwrap();
+        assert_eq!(its.len(), 1, "{order}");
+        let cells: Vec<(Meta, Meta)> =
+            serde_json::from_value(its[0]["destinations"].clone()).unwrap();
+        assert_eq!(cells.len(), 1, "{order}");
+        assert_eq!(cells[0].1, Meta::new(0, 1, 1), "{order}");
+        cells[0].0
+    };
+    assert_eq!(destination("paper"), Meta::new(1, 1, 1));
+    assert_eq!(destination("supported"), Meta::new(0, 0, 1));
+    // The joints it weighs: (1, 1, 1) holds on to (1, 0, 1) alone, by one
+    // connector; (0, 0, 1) to (0, 0, 0) by four and to (1, 0, 1) by one.
+    assert_eq!(Meta::new(1, 1, 1).joints(Meta::new(1, 0, 1)), 1);
+    assert_eq!(Meta::new(0, 0, 1).joints(Meta::new(0, 0, 0)), 4);
+    // The bundled L -> C-36 in this order names the model it certifies
+    // under (docs/repost.md): connectors at 125 kPa, the base at 100.
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sc = reconfcheck::scenario::Scenario::load(
+        &root.join("scenarios/repost-l-to-c-36-supported.toml"),
+    )
+    .unwrap();
+    assert_eq!(sc.parameters["goal_order"].as_str(), Some("supported"));
+    let model =
+        reconfcheck::mechanics::Model::load(&sc.resolve(sc.model.as_ref().unwrap())).unwrap();
+    assert_eq!(
+        (model.connector.pressure, model.ground.pressure),
+        (125e3, 100e3)
+    );
+}
+
 /// The porous structure's joints, counted from the lattice's neighbours:
 /// two SPARSE meta-modules side by side (along X or Y) touch through
 /// exactly one catom–catom connector, one above the other through four.
@@ -680,6 +747,8 @@ fn a_sparse_meta_module_hangs_on_one_connector_from_a_side_neighbour_and_breaks_
         for (d, n) in [((1, 0, 0), 1), ((0, 1, 0), 1), ((0, 0, 1), 4)] {
             let next = Meta::new(m.x + d.0, m.y + d.1, m.z + d.2);
             assert_eq!(joints(m, next), n, "{m:?} to {next:?}");
+            assert_eq!(m.joints(next), n, "the planner's count, {m:?} to {next:?}");
+            assert_eq!(next.joints(m), n, "{next:?} to {m:?}");
         }
     }
     let model = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/catom-3.6mm.toml");

@@ -38,6 +38,21 @@ impl Meta {
     pub fn adjacent(self) -> impl Iterator<Item = Meta> {
         Direction::ALL.into_iter().map(move |d| self.step(d))
     }
+
+    /// The catom–catom connectors between this SPARSE meta-module and
+    /// `other`'s (lattice neighbours, one loop in each): one side by side
+    /// (along X or Y), four stacked; 0 for meta-modules that do not touch.
+    pub fn joints(self, other: Meta) -> usize {
+        use crate::lattice::{FccLattice, Lattice};
+        let (a, b) = (self.sparse_cells(), other.sparse_cells());
+        a.iter()
+            .map(|x| {
+                b.iter()
+                    .filter(|y| FccLattice.are_neighbours(*x, **y))
+                    .count()
+            })
+            .sum()
+    }
 }
 
 /// The breadth-first spanning tree of the meta-modules `present` from

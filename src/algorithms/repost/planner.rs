@@ -111,6 +111,14 @@ pub enum GoalOrder {
     /// built (no meta-module hangs from its destination while it is
     /// assembled). On L → C: 11 iterations against the paper's 7.
     BottomUp,
+    /// Stricter, ours: the paper's goal cells, but each is assembled from
+    /// the neighbour that holds it best: the most catom–catom connectors
+    /// to the new meta-module ([`Meta::joints`]: four from below, one from
+    /// a side), then the most to the rest of the structure (its sources
+    /// left out). The paper
+    /// takes any SPARSE neighbour; one that itself hangs on one side
+    /// connector then carries the new meta-module's catoms as well.
+    Supported,
 }
 
 impl GoalOrder {
@@ -119,6 +127,7 @@ impl GoalOrder {
         match s {
             "paper" => Some(GoalOrder::Paper),
             "bottom-up" => Some(GoalOrder::BottomUp),
+            "supported" => Some(GoalOrder::Supported),
             _ => None,
         }
     }
@@ -127,6 +136,7 @@ impl GoalOrder {
         match self {
             GoalOrder::Paper => "paper",
             GoalOrder::BottomUp => "bottom-up",
+            GoalOrder::Supported => "supported",
         }
     }
 }
@@ -300,7 +310,7 @@ fn plan_with(
         let mut empty_sorted: Vec<Meta> = empty
             .iter()
             .filter(|m| {
-                order == GoalOrder::Paper
+                order != GoalOrder::BottomUp
                     || m.z == low
                     || state.contains_key(&m.step(super::metamodule::Direction::Down))
             })
@@ -313,9 +323,28 @@ fn plan_with(
         let mut taken: FxHashSet<Meta> = FxHashSet::default();
         let mut destinations: Vec<(Meta, Meta)> = Vec::new();
         for e in &empty_sorted {
-            if let Some(d) = e.adjacent().find(|d| {
+            let mut candidates = e.adjacent().filter(|d| {
                 goal.contains_key(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
-            }) {
+            });
+            let chosen = if order == GoalOrder::Supported {
+                // The first of the best, so ties keep the paper's choice;
+                // this iteration's sources leave while `e` is assembled.
+                let held = |d: &Meta| {
+                    let rest: usize = d
+                        .adjacent()
+                        .filter(|n| n != e && state.contains_key(n) && !sources.contains(n))
+                        .map(|n| d.joints(n))
+                        .sum();
+                    (d.joints(*e), rest)
+                };
+                candidates.fold(None, |best: Option<Meta>, d| match best {
+                    Some(b) if held(&b) >= held(&d) => Some(b),
+                    _ => Some(d),
+                })
+            } else {
+                candidates.next()
+            };
+            if let Some(d) = chosen {
                 taken.insert(d);
                 destinations.push((d, *e));
             }
