@@ -114,10 +114,10 @@ pub enum GoalOrder {
     /// Stricter, ours: the paper's goal cells, but each is assembled from
     /// the neighbour that holds it best: the most catom–catom connectors
     /// to the new meta-module ([`Meta::joints`]: four from below, one from
-    /// a side), then the most to the rest of the structure (its sources
-    /// left out). The paper
-    /// takes any SPARSE neighbour; one that itself hangs on one side
-    /// connector then carries the new meta-module's catoms as well.
+    /// a side), then the most to the rest of the structure (the sources
+    /// that leave in this iteration left out). The paper takes any SPARSE
+    /// neighbour; one that itself hangs on one side connector then carries
+    /// the new meta-module's catoms as well.
     Supported,
 }
 
@@ -328,11 +328,17 @@ fn plan_with(
             });
             let chosen = if order == GoalOrder::Supported {
                 // The first of the best, so ties keep the paper's choice;
-                // this iteration's sources leave while `e` is assembled.
+                // this iteration's SPARSE sources leave while `e` is
+                // assembled (a FULL one stays, SPARSE).
+                let stays = |n: &Meta| match state.get(n) {
+                    Some(State::Sparse) => !sources.contains(n),
+                    Some(State::Full) => true,
+                    _ => false,
+                };
                 let held = |d: &Meta| {
                     let rest: usize = d
                         .adjacent()
-                        .filter(|n| n != e && state.contains_key(n) && !sources.contains(n))
+                        .filter(|n| n != e && stays(n))
                         .map(|n| d.joints(n))
                         .sum();
                     (d.joints(*e), rest)
