@@ -764,11 +764,7 @@ mod tests {
         for mirror in [false, true] {
             let col = leaning_column(mirror);
             let r = certify(&col, &opts(Some("catom-3.6mm.toml"))).unwrap();
-            let v: Vec<_> = r
-                .violations
-                .iter()
-                .filter(|v| v.kind == ViolationKind::Unstable)
-                .collect();
+            let v: Vec<_> = r.violations_of(ViolationKind::Unstable).collect();
             assert_eq!(v.len(), 1, "the final configuration: {}", r.summary());
             assert!(
                 v[0].message.contains("3 module(s) tip over"),
@@ -817,11 +813,7 @@ mod tests {
         // one module plus the agent does not (4 > 1.55).
         let r = certify(&branch_schedule(1), &opts(Some("catom-3.6mm-10kpa.toml"))).unwrap();
         assert!(!r.certified);
-        let v: Vec<_> = r
-            .violations
-            .iter()
-            .filter(|v| v.kind == ViolationKind::Overload)
-            .collect();
+        let v: Vec<_> = r.violations_of(ViolationKind::Overload).collect();
         assert_eq!(v.len(), 2, "{}", r.summary()); // the step and the final structure
         assert_eq!(v[0].step, 1);
         assert_eq!(

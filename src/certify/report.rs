@@ -261,6 +261,11 @@ impl Report {
         self.window.is_none_or(|w| w.holds(k, self.steps))
     }
 
+    /// The violations of one kind, in report order.
+    pub fn violations_of(&self, kind: ViolationKind) -> impl Iterator<Item = &Violation> {
+        self.violations.iter().filter(move |v| v.kind == kind)
+    }
+
     /// Counts of violations by kind.
     pub fn violation_counts(&self) -> BTreeMap<ViolationKind, usize> {
         let mut m = BTreeMap::new();

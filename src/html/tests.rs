@@ -93,9 +93,7 @@ fn the_page_places_every_violation_at_its_step_with_its_witness_points() {
     let s = colliding_walk();
     let report = certify::certify(&s, &Options::default()).unwrap();
     let collisions: Vec<&Violation> = report
-        .violations
-        .iter()
-        .filter(|v| v.kind == crate::certify::ViolationKind::Collision)
+        .violations_of(crate::certify::ViolationKind::Collision)
         .collect();
     assert!(!collisions.is_empty(), "the obstacle is cut");
     let data = page_data("walk", &report, &s);

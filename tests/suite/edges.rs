@@ -160,9 +160,7 @@ fn a_free_floating_structure_that_stays_one_component_is_connected_on_every_step
     let r = certify(&s, &Options::lattice_only()).unwrap();
     assert!(!r.certified);
     let loose: Vec<_> = r
-        .violations
-        .iter()
-        .filter(|v| v.kind == reconfcheck::certify::ViolationKind::Disconnected)
+        .violations_of(reconfcheck::certify::ViolationKind::Disconnected)
         .collect();
     assert!(!loose.is_empty(), "{:?}", r.violations);
 }

@@ -116,9 +116,7 @@ fn dip_under_a_pivot(ground_layer: Option<i32>, mirror: bool) -> reconfcheck::sc
 
 fn ground_collisions(s: &reconfcheck::schedule::Schedule) -> Vec<f64> {
     let r = certify(s, &Options::default()).unwrap();
-    r.violations
-        .iter()
-        .filter(|v| v.kind == ViolationKind::GroundCollision)
+    r.violations_of(ViolationKind::GroundCollision)
         .map(|v| v.detail["depth"].as_f64().unwrap())
         .collect()
 }

@@ -85,8 +85,8 @@ proptest! {
         }
 
         let r = lattice_report(&s);
-        let got: BTreeSet<usize> = r.violations.iter()
-            .filter(|v| v.kind == ViolationKind::Disconnected && v.modules == vec![10_000])
+        let got: BTreeSet<usize> = r.violations_of(ViolationKind::Disconnected)
+            .filter(|v| v.modules == vec![10_000])
             .map(|v| v.step)
             .collect();
         prop_assert!(r.violations.iter().all(|v| v.kind == ViolationKind::Disconnected));

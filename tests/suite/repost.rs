@@ -774,11 +774,7 @@ fn a_sparse_meta_module_hangs_on_one_connector_from_a_side_neighbour_and_breaks_
     };
     assert!(hanging(Meta::new(1, 0, 0)).certified, "along X it holds");
     let r = hanging(Meta::new(0, 1, 0));
-    let v: Vec<_> = r
-        .violations
-        .iter()
-        .filter(|v| v.kind == ViolationKind::Overload)
-        .collect();
+    let v: Vec<_> = r.violations_of(ViolationKind::Overload).collect();
     assert_eq!(v.len(), 1, "{}", r.summary());
     let lf = v[0].detail["load_factor"].as_f64().unwrap();
     assert!((lf - 0.939).abs() < 1e-3, "{lf}");

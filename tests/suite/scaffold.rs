@@ -347,9 +347,7 @@ fn concurrent_movers_of_one_step_never_collide() {
         let r = certify(&s, &Options::default()).unwrap();
         assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
         let collisions: Vec<_> = r
-            .violations
-            .iter()
-            .filter(|v| v.kind == ViolationKind::Collision)
+            .violations_of(ViolationKind::Collision)
             .map(|v| &v.message)
             .collect();
         assert!(collisions.is_empty(), "{shape:?}, b = {b}: {collisions:?}");
@@ -635,11 +633,7 @@ fn the_papers_protocol_collides_13_times_on_the_2_pyramid() {
     let s = scaffold_schedule_with(&ShapeSpec::Pyramid { h: 2 }, 6, Protocol::Paper).unwrap();
     let r = certify(&s, &Options::default()).unwrap();
     assert!(r.checks.iter().any(|c| c == "collision"), "{:?}", r.checks);
-    let collisions: Vec<_> = r
-        .violations
-        .iter()
-        .filter(|v| v.kind == ViolationKind::Collision)
-        .collect();
+    let collisions: Vec<_> = r.violations_of(ViolationKind::Collision).collect();
     assert_eq!(collisions.len(), 13, "{}", r.summary());
     assert!(
         r.violations.iter().all(|v| !v.kind.is_lattice_level()),
