@@ -137,7 +137,7 @@ pub struct PlannerParams {
     pub goal: String,
     #[serde(default = "default_spacing")]
     pub spacing_mm: f64,
-    /// "paper" (default), "bottom-up" or "supported" (see
+    /// "paper" (default), "bottom-up", "supported" or "paired" (see
     /// [`planner::GoalOrder`]).
     #[serde(default)]
     pub goal_order: Option<String>,
@@ -230,7 +230,7 @@ pub fn plan_scenario(scenario: &Scenario) -> Result<Planned, InputError> {
         "goal_order",
         p.goal_order.as_deref(),
         planner::GoalOrder::parse,
-        "paper, bottom-up, supported",
+        "paper, bottom-up, supported, paired",
     )?;
     let plan = planner::plan(&initial, &goal, rules, order).map_err(|e| {
         let file = match e {

@@ -185,6 +185,17 @@ pub struct Pipelined {
     pub lanes_at: Vec<usize>,
 }
 
+/// One catom's path, committed in order: its lane (streamline) and the
+/// earlier commits that must have arrived before it sets off.
+#[derive(Clone, Debug)]
+pub struct Commit {
+    pub lane: usize,
+    pub path: Vec<Hop>,
+    /// Indices of earlier commits: this catom leaves no earlier than the
+    /// step at which the last of them is at rest in its goal cell.
+    pub after: Vec<usize>,
+}
+
 /// The catoms of each lane (one path per catom, in the order planned)
 /// pipelined and the lanes side by side; `None` when a catom fits
 /// nowhere (not even after everything committed; the sequential plan
@@ -192,6 +203,31 @@ pub struct Pipelined {
 pub fn pipeline(
     before: &Scene,
     lanes: &[Vec<Vec<Hop>>],
+    rules: &dyn MotionRules,
+) -> Option<Pipelined> {
+    let commits: Vec<Commit> = lanes
+        .iter()
+        .enumerate()
+        .flat_map(|(lane, paths)| {
+            paths.iter().map(move |p| Commit {
+                lane,
+                path: p.clone(),
+                after: Vec::new(),
+            })
+        })
+        .collect();
+    pipeline_commits(before, &commits, rules)
+}
+
+/// [`pipeline`] with the paths committed in the order given, which need
+/// not be lane after lane (a pair of goal meta-modules assembled
+/// together interleaves its two lanes), each no earlier than its lane's
+/// previous catom and than the arrivals it waits for. The order must be
+/// the one the paths were planned in: run one after another, they are
+/// valid, which is what makes the search end.
+pub fn pipeline_commits(
+    before: &Scene,
+    commits: &[Commit],
     rules: &dyn MotionRules,
 ) -> Option<Pipelined> {
     let mut tl = Timeline {
@@ -202,28 +238,34 @@ pub fn pipeline(
         moves: Vec::new(),
         pivot_last: FxHashMap::default(),
     };
-    let mut spans = Vec::new();
-    for lane in lanes {
-        let mut earliest = 0;
-        let mut span: Option<(usize, usize)> = None;
-        for path in lane {
-            let Some(first) = path.first() else {
-                continue;
-            };
-            let start = first.from;
-            let horizon = tl.moves.len();
-            let t0 = (earliest..=horizon.max(earliest)).find(|&t0| tl.fits(start, path, t0))?;
-            tl.commit(start, path, t0);
-            earliest = t0 + 1;
-            let end = t0 + path.len() - 1;
-            span = Some(span.map_or((t0, end), |(a, b)| (a.min(t0), b.max(end))));
-        }
-        spans.extend(span);
+    let lanes = commits.iter().map(|c| c.lane + 1).max().unwrap_or(0);
+    let mut earliest = vec![0; lanes];
+    let mut spans: Vec<Option<(usize, usize)>> = vec![None; lanes];
+    // Each commit's first step at rest in its goal cell.
+    let mut arrival: Vec<usize> = Vec::with_capacity(commits.len());
+    for c in commits {
+        let path = &c.path;
+        let wait = c.after.iter().map(|&i| arrival[i]).max().unwrap_or(0);
+        let Some(first) = path.first() else {
+            arrival.push(wait);
+            continue;
+        };
+        let start = first.from;
+        let horizon = tl.moves.len();
+        let lo = earliest[c.lane].max(wait);
+        let t0 = (lo..=horizon.max(lo)).find(|&t0| tl.fits(start, path, t0))?;
+        tl.commit(start, path, t0);
+        earliest[c.lane] = t0 + 1;
+        arrival.push(t0 + path.len());
+        let end = t0 + path.len() - 1;
+        let span = &mut spans[c.lane];
+        *span = Some(span.map_or((t0, end), |(a, b)| (a.min(t0), b.max(end))));
     }
     assert!(
         (0..tl.moves.len()).all(|t| tl.anchored(t, None)),
         "every commit checks the steps its absence affects"
     );
+    let spans: Vec<(usize, usize)> = spans.into_iter().flatten().collect();
     let lanes_at = (0..tl.moves.len())
         .map(|t| spans.iter().filter(|(a, b)| *a <= t && t <= *b).count())
         .collect();
@@ -296,6 +338,41 @@ mod tests {
                 seen.len() == rest.len()
             })
             .collect()
+    }
+
+    /// A commit that names an earlier one leaves only once that one has
+    /// arrived; without it both leave at once (F fixed, A and B beside it).
+    #[test]
+    fn a_commit_waits_for_the_arrivals_it_names() {
+        let [f, a, b] = [(0, 0), (1, 0), (-1, 0)].map(|(x, y)| c(x, y));
+        let mut before = Scene {
+            at: FxHashMap::default(),
+            fixed: FxHashSet::default(),
+            ground: None,
+            lo: c(-5, -5),
+            hi: c(5, 5),
+            region: None,
+        };
+        for (i, x) in [f, a, b].into_iter().enumerate() {
+            before.insert(i as ModuleId, x);
+        }
+        before.fixed.insert(0);
+        let first = Commit {
+            lane: 0,
+            path: vec![hop(a, c(0, 1), f)],
+            after: Vec::new(),
+        };
+        let second = |after: Vec<usize>| Commit {
+            lane: 1,
+            path: vec![hop(b, c(0, -1), f)],
+            after,
+        };
+        let leaves = |commits: &[Commit]| {
+            let p = pipeline_commits(&before, commits, &Free).expect("fits");
+            p.steps.iter().position(|st| st.iter().any(|h| h.from == b))
+        };
+        assert_eq!(leaves(&[first.clone(), second(Vec::new())]), Some(0));
+        assert_eq!(leaves(&[first, second(vec![0])]), Some(1));
     }
 
     /// In one layer, F (fixed) holds R, R2 and S up through two routes:

@@ -26,12 +26,13 @@
 //!    ([`super::operations::move_catoms`]); then they run pipelined, one
 //!    behind another, the streamlines side by side
 //!    ([`super::pipeline`]), or one at a time if a catom fits nowhere in
-//!    the pipeline.
+//!    the pipeline. In [`GoalOrder::Paired`] two goal cells of a row are
+//!    transported together (`transport_pair`), their lanes interleaved.
 
 use super::messages::{self, IterationRecord, Messages};
 use super::metamodule::{Meta, State, spanning_tree};
 use super::operations::{DEEP_SEARCH_BUDGET, FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
-use super::pipeline::pipeline;
+use super::pipeline::{Commit, pipeline_commits};
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
 use crate::lattice::Cell;
@@ -119,6 +120,16 @@ pub enum GoalOrder {
     /// neighbour; one that itself hangs on one side connector then carries
     /// the new meta-module's catoms as well.
     Supported,
+    /// Stricter still, ours: [`GoalOrder::Supported`], and a goal cell
+    /// that would hang on one side connector (no other joint to what
+    /// stays) is assembled together with a side neighbour in the goal,
+    /// each loop grown from its holder towards the other along the
+    /// shorter arc, and neither completed before the two arcs have met
+    /// (a SPARSE meta-module alone on one connector along Y breaks it at
+    /// 100 kPa; the pair holds with margin: `docs/repost.md`). A cell
+    /// whose partner gets no streamline in an iteration waits for one,
+    /// unless nothing else would move.
+    Paired,
 }
 
 impl GoalOrder {
@@ -128,6 +139,7 @@ impl GoalOrder {
             "paper" => Some(GoalOrder::Paper),
             "bottom-up" => Some(GoalOrder::BottomUp),
             "supported" => Some(GoalOrder::Supported),
+            "paired" => Some(GoalOrder::Paired),
             _ => None,
         }
     }
@@ -137,6 +149,7 @@ impl GoalOrder {
             GoalOrder::Paper => "paper",
             GoalOrder::BottomUp => "bottom-up",
             GoalOrder::Supported => "supported",
+            GoalOrder::Paired => "paired",
         }
     }
 }
@@ -165,6 +178,35 @@ fn region(m: Meta) -> impl Iterator<Item = Cell> {
     (-1..=2).flat_map(move |x| {
         (-1..=1).flat_map(move |y| (0..=4).map(move |z| Cell::new(l.x + x, l.y + y, l.z + z)))
     })
+}
+
+/// `scene` confined to the transport region: the boxes of `metas` grown
+/// by `margin` cells in x and y, or with `None` the structure's box with
+/// `targets`, grown by three cells.
+fn within<'a>(
+    scene: &Scene,
+    metas: impl Iterator<Item = &'a Meta>,
+    margin: Option<i32>,
+    targets: &[Cell],
+) -> Scene {
+    let mut s = scene.clone();
+    match margin {
+        Some(margin) => {
+            let mut reg: FxHashSet<Cell> = FxHashSet::default();
+            for m in metas {
+                for c in region(*m) {
+                    for dx in -margin..=margin {
+                        for dy in -margin..=margin {
+                            reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
+                        }
+                    }
+                }
+            }
+            s.region = Some(reg);
+        }
+        None => s.fit_box(targets, 3),
+    }
+    s
 }
 
 /// The global coordinator: the lowest meta-module in both shapes.
@@ -242,6 +284,10 @@ fn plan_with(
         });
     }
     let gc = coordinator(initial, goal).ok_or(PlanError::NoCoordinator)?;
+    // Meta-modules on this layer rest on the ground: none hangs.
+    let floor = initial.keys().map(|m| m.z).min().unwrap_or(0);
+    // Each goal cell's distance from the coordinator inside the goal.
+    let reach = spanning_tree(|m| goal.contains_key(m), gc).depth;
     let ground = 4 * initial.keys().map(|m| m.z).min().unwrap_or(0);
     let mut scene = Scene::new(Some(ground));
     let mut modules = Vec::new();
@@ -326,7 +372,7 @@ fn plan_with(
             let mut candidates = e.adjacent().filter(|d| {
                 goal.contains_key(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
             });
-            let chosen = if order == GoalOrder::Supported {
+            let chosen = if matches!(order, GoalOrder::Supported | GoalOrder::Paired) {
                 // The first of the best, so ties keep the paper's choice;
                 // this iteration's SPARSE sources leave while `e` is
                 // assembled (a FULL one stays, SPARSE).
@@ -373,8 +419,33 @@ fn plan_with(
         let before = scene.clone();
         let present = state.clone();
         let mut lanes: Vec<Vec<Vec<Hop>>> = Vec::new();
+        // Lanes assembled as pairs: (first lane, the commit order of
+        // their paths).
+        let mut pair_commits: Vec<(usize, Vec<PairCommit>)> = Vec::new();
         let mut planned: Vec<Vec<Meta>> = Vec::new();
         let mut deferred: FxHashSet<Meta> = FxHashSet::default();
+        let partners = |e: Meta| -> Vec<Meta> {
+            if order != GoalOrder::Paired || e.z == floor || present.contains_key(&e) {
+                return Vec::new();
+            }
+            let stays = |n: &Meta| match present.get(n) {
+                Some(State::Sparse) => !sources.contains(n),
+                Some(State::Full) => true,
+                _ => false,
+            };
+            let held: usize = e.adjacent().filter(stays).map(|n| e.joints(n)).sum();
+            if held > 1 {
+                return Vec::new();
+            }
+            e.adjacent()
+                .filter(|p| {
+                    p.z == e.z
+                        && goal.contains_key(p)
+                        && !present.contains_key(p)
+                        && destinations.iter().any(|(d, g)| g == p && d != g)
+                })
+                .collect()
+        };
         let mut stuck = None;
         loop {
             let open: Vec<Meta> = sources
@@ -393,19 +464,70 @@ fn plan_with(
                 })
                 .copied()
                 .collect();
-            let lines = streamlines(&state, &open, &open_dest);
+            let open_dest = if order == GoalOrder::Paired {
+                paired_first(&state, &open, &open_dest, &partners, &reach)
+            } else {
+                open_dest
+            };
+            let mut lines = streamlines(&state, &open, &open_dest);
             if lines.is_empty() {
                 break;
             }
-            let mut progress = false;
-            for line in lines {
-                let (src, dst) = (line[0], *line.last().expect("a streamline has an end"));
-                let goal_meta = open_dest
+            if order == GoalOrder::Paired {
+                // A source resting on another goes first (below).
+                lines.sort_by_key(|l| std::cmp::Reverse(l[0].z));
+            }
+            let goal_of = |line: &[Meta]| {
+                let dst = *line.last().expect("a streamline has an end");
+                open_dest
                     .iter()
                     .find(|(d, _)| *d == dst)
                     .map(|(_, e)| *e)
-                    .expect("a destination has its goal cell");
-                let fill = goal_meta == dst;
+                    .expect("a destination has its goal cell")
+            };
+            let served: Vec<Meta> = lines.iter().map(|l| goal_of(l)).collect();
+            let mut progress = false;
+            let mut paired: FxHashSet<Meta> = FxHashSet::default();
+            for (k, line) in lines.iter().enumerate() {
+                let src = line[0];
+                let goal_meta = served[k];
+                if paired.contains(&goal_meta) {
+                    continue;
+                }
+                // Its partner's streamline, when both are to be assembled
+                // now: the two loops grow towards each other.
+                let sparse = |l: &[Meta]| state.get(&l[0]) == Some(&State::Sparse);
+                let mate = partners(goal_meta).into_iter().find_map(|p| {
+                    let j = served.iter().position(|e| *e == p)?;
+                    (j != k && !paired.contains(&p) && sparse(line) && sparse(&lines[j]))
+                        .then_some(j)
+                });
+                if let Some(j) = mate {
+                    let (other, partner) = (&lines[j], served[j]);
+                    if let Some((a, b, commit)) =
+                        transport_pair(&scene, line, goal_meta, other, partner)
+                    {
+                        for p in a.iter().chain(&b) {
+                            let (x, y) = (p[0].from, p[p.len() - 1].to);
+                            let id = scene.at.remove(&x).expect("mover in place");
+                            scene.insert(id, y);
+                        }
+                        let base = lanes.len();
+                        pair_commits.push((base, commit));
+                        lanes.push(a);
+                        lanes.push(b);
+                        for (l, g) in [(line, goal_meta), (other, partner)] {
+                            state.remove(&l[0]);
+                            state.insert(g, State::Sparse);
+                            planned.push(l.clone());
+                            paired.insert(g);
+                        }
+                        progress = true;
+                        continue;
+                    }
+                }
+                let line = line.clone();
+                let fill = goal_meta == *line.last().expect("a streamline has an end");
                 match transport(&scene, &line, state[&src], goal_meta, fill) {
                     Ok(paths) => {
                         // The next streamline plans against this one's end state.
@@ -449,21 +571,37 @@ fn plan_with(
         let streamlines = planned;
         let motions: usize = lanes.iter().flatten().map(Vec::len).sum();
         scene = before.clone();
-        let pipelined = match pipeline(&before, &lanes, rules) {
+        // `Paired`: a source resting on another source is dismantled
+        // before the one under it sets off, which would otherwise leave
+        // its last catoms hanging from its side neighbours.
+        let waits: Vec<(usize, usize)> = if order == GoalOrder::Paired {
+            (0..streamlines.len())
+                .filter_map(|l| {
+                    let up = streamlines[l][0].step(super::metamodule::Direction::Up);
+                    let u = streamlines.iter().position(|p| p[0] == up)?;
+                    (u < l).then_some((l, u))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let commits = commit_order(&lanes, &pair_commits, &waits);
+        let pipelined = match pipeline_commits(&before, &commits, rules) {
             Some(p) => {
                 emit(&mut scene, p.steps, p.lanes_at, &mut out);
                 true
             }
             None => {
                 // No pipeline (a catom that fits nowhere): run the
-                // streamlines one after another, the order they were
-                // planned in (valid by construction).
-                for lane in lanes {
-                    let steps: Vec<Vec<Hop>> =
-                        lane.into_iter().flatten().map(|h| vec![h]).collect();
-                    let n = steps.len();
-                    emit(&mut scene, steps, vec![1; n], &mut out);
-                }
+                // catoms one after another, in the order they were
+                // planned (valid by construction).
+                let steps: Vec<Vec<Hop>> = commits
+                    .into_iter()
+                    .flat_map(|c| c.path)
+                    .map(|h| vec![h])
+                    .collect();
+                let n = steps.len();
+                emit(&mut scene, steps, vec![1; n], &mut out);
                 false
             }
         };
@@ -541,23 +679,7 @@ fn transport(
         .iter()
         .flat_map(|&b| [Some(0), Some(1), None].map(|m| (b, m)))
     {
-        let mut s = scene.clone();
-        match margin {
-            Some(margin) => {
-                let mut reg: FxHashSet<Cell> = FxHashSet::default();
-                for m in line.iter().chain([&goal_meta]) {
-                    for c in region(*m) {
-                        for dx in -margin..=margin {
-                            for dy in -margin..=margin {
-                                reg.insert(Cell::new(c.x + dx, c.y + dy, c.z));
-                            }
-                        }
-                    }
-                }
-                s.region = Some(reg);
-            }
-            None => s.fit_box(&targets, 3),
-        }
+        let s = within(scene, line.iter().chain([&goal_meta]), margin, &targets);
         for strict in [true, false] {
             for order in &orders {
                 match move_catoms(&mut s.clone(), &from, order, strict, budget) {
@@ -568,6 +690,299 @@ fn transport(
         }
     }
     Err(last)
+}
+
+/// The destinations of a `GoalOrder::Paired` iteration, chosen greedily
+/// (the sets of destinations that vertex-disjoint streamlines can serve
+/// together form a matroid, a gammoid, so the greedy choice serves as
+/// many as the plain maximum flow): first each pair of cells that would
+/// hang on one side connector alone, both or neither; then the other
+/// cells, those farthest from the coordinator first (the arms' far rows
+/// get their holders while sources remain to assemble them as pairs). A
+/// cell that would hang alone and has no partner to go with waits; if
+/// nothing else can be served, every destination is open, as in the paper.
+fn paired_first(
+    state: &BTreeMap<Meta, State>,
+    open: &[Meta],
+    open_dest: &[(Meta, Meta)],
+    partners: &dyn Fn(Meta) -> Vec<Meta>,
+    reach: &FxHashMap<Meta, usize>,
+) -> Vec<(Meta, Meta)> {
+    let mut units: Vec<Vec<(Meta, Meta)>> = Vec::new();
+    for &(d, e) in open_dest {
+        for p in partners(e) {
+            if let Some(&dp) = open_dest.iter().find(|(_, g)| *g == p)
+                && e < p
+            {
+                units.push(vec![(d, e), dp]);
+            }
+        }
+    }
+    let mut singles: Vec<(Meta, Meta)> = open_dest
+        .iter()
+        .filter(|(_, e)| partners(*e).is_empty())
+        .copied()
+        .collect();
+    singles.sort_by_key(|(_, e)| std::cmp::Reverse(reach.get(e).copied().unwrap_or(0)));
+    units.extend(singles.into_iter().map(|x| vec![x]));
+    let mut chosen: Vec<(Meta, Meta)> = Vec::new();
+    for u in units {
+        if u.iter()
+            .any(|x| chosen.iter().any(|c| c.0 == x.0 || c.1 == x.1))
+        {
+            continue;
+        }
+        let mut trial = chosen.clone();
+        trial.extend(&u);
+        if streamlines(state, open, &trial).len() == trial.len() {
+            chosen = trial;
+        }
+    }
+    if chosen.is_empty() {
+        open_dest.to_vec()
+    } else {
+        chosen
+    }
+}
+
+/// A path of a pair assembled together ([`transport_pair`]): which of
+/// the two lanes, its index there, and the earlier paths of the pair (by
+/// their place in the pair's order) that must have arrived first.
+#[derive(Clone, Debug)]
+struct PairCommit {
+    second: bool,
+    index: usize,
+    after: Vec<usize>,
+}
+
+/// A pair's paths: the first lane's, the second's, and their order.
+type PairPaths = (Vec<Vec<Hop>>, Vec<Vec<Hop>>, Vec<PairCommit>);
+
+/// Every lane's paths in the order they were planned: lane after lane,
+/// but a pair's two lanes (`pairs`: first lane, order) interleaved; a
+/// lane of `waits` (lane, earlier lane) sets off only once the earlier
+/// lane's catoms have all arrived.
+fn commit_order(
+    lanes: &[Vec<Vec<Hop>>],
+    pairs: &[(usize, Vec<PairCommit>)],
+    waits: &[(usize, usize)],
+) -> Vec<Commit> {
+    let mut out: Vec<Commit> = Vec::new();
+    let mut lane = 0;
+    while lane < lanes.len() {
+        if let Some((_, order)) = pairs.iter().find(|(first, _)| *first == lane) {
+            let start = out.len();
+            for c in order {
+                let l = lane + usize::from(c.second);
+                out.push(Commit {
+                    lane: l,
+                    path: lanes[l][c.index].clone(),
+                    after: c.after.iter().map(|i| start + i).collect(),
+                });
+            }
+            lane += 2;
+        } else {
+            out.extend(lanes[lane].iter().map(|p| Commit {
+                lane,
+                path: p.clone(),
+                after: Vec::new(),
+            }));
+            lane += 1;
+        }
+    }
+    for &(l, u) in waits {
+        let Some(last) = out.iter().rposition(|c| c.lane == u) else {
+            continue;
+        };
+        for c in out.iter_mut().skip(last + 1).filter(|c| c.lane == l) {
+            c.after.push(last);
+        }
+    }
+    out
+}
+
+/// The loop of `e` split for a pair: the arc from its cell joined to
+/// `holder` to its cell joined to `partner`, the shorter way round (both
+/// ends included), then the rest of the loop onwards from the arc's end.
+/// `None` unless each is joined by exactly one cell (side neighbours).
+fn arcs(e: Meta, holder: Meta, partner: Meta) -> Option<(Vec<Cell>, Vec<Cell>)> {
+    use crate::lattice::{FccLattice, Lattice};
+    let cells = e.sparse_cells();
+    let joined = |m: Meta| {
+        let other = m.sparse_cells();
+        let mut at = (0..10).filter(|&i| {
+            other
+                .iter()
+                .any(|c| FccLattice.are_neighbours(cells[i], *c))
+        });
+        let i = at.next()?;
+        at.next().is_none().then_some(i)
+    };
+    let (a, b) = (joined(holder)?, joined(partner)?);
+    let forward = (b + 10 - a) % 10;
+    let step = if forward <= 5 { 1 } else { 9 };
+    let mut arc = vec![a];
+    let mut i = a;
+    while i != b {
+        i = (i + step) % 10;
+        arc.push(i);
+    }
+    let mut rest = Vec::new();
+    i = (b + step) % 10;
+    while i != a {
+        rest.push(i);
+        i = (i + step) % 10;
+    }
+    let order: Vec<usize> = arc.iter().chain(&rest).copied().collect();
+    // Each catom latches the one before it (the loop's own order).
+    let linked = order
+        .windows(2)
+        .all(|w| w[1] == arc[0] || FccLattice.are_neighbours(cells[w[0]], cells[w[1]]));
+    linked.then(|| {
+        (
+            arc.iter().map(|&i| cells[i]).collect(),
+            rest.iter().map(|&i| cells[i]).collect(),
+        )
+    })
+}
+
+/// Two SPARSE goal meta-modules side by side, each hanging on one side
+/// connector from its destination, assembled together: each streamline's
+/// catoms first build the arc of its loop towards the other, then the
+/// rest, which sets off only once both arcs are in place (so neither
+/// meta-module hangs complete, or nearly, on its connector alone). The
+/// paths of each lane and their order; `None` if the split does not
+/// apply or no region or mode finds it (then each is transported alone).
+fn transport_pair(
+    scene: &Scene,
+    line_a: &[Meta],
+    a: Meta,
+    line_b: &[Meta],
+    b: Meta,
+) -> Option<PairPaths> {
+    let (arc_a, rest_a) = arcs(a, *line_a.last()?, b)?;
+    let (arc_b, rest_b) = arcs(b, *line_b.last()?, a)?;
+    let (from_a, from_b) = (line_a[0].sparse_cells(), line_b[0].sparse_cells());
+    // Each rest may be grown from either end of its arc: from the
+    // partner's joint onwards or from the holder's joint back.
+    let backwards = |r: &[Cell]| r.iter().rev().copied().collect::<Vec<Cell>>();
+    let rests = [
+        (rest_a.clone(), rest_b.clone()),
+        (backwards(&rest_a), backwards(&rest_b)),
+        (rest_a.clone(), backwards(&rest_b)),
+        (backwards(&rest_a), rest_b.clone()),
+    ];
+    // The regions of `transport`, widening; in each, strictly first.
+    let tries: Vec<(Scene, bool, usize)> = [Some(0), Some(1), None]
+        .into_iter()
+        .map(|m| (SEARCH_BUDGET, m))
+        .flat_map(|(budget, margin)| {
+            let all: Vec<Cell> = a
+                .sparse_cells()
+                .into_iter()
+                .chain(b.sparse_cells())
+                .collect();
+            let metas = line_a.iter().chain(line_b).chain([&a, &b]);
+            let s = within(scene, metas, margin, &all);
+            [true, false].map(|strict| (s.clone(), strict, budget))
+        })
+        .collect();
+    // The fewest catoms of one loop before the other's arc joins it (none
+    // beyond its own arc if the paths allow, at most `PAIR_EARLY` more),
+    // in any region; else each is transported alone.
+    for k in 0..=PAIR_EARLY {
+        for (s, strict, budget) in &tries {
+            for swap in [false, true] {
+                for (ra, rb) in &rests {
+                    let found = if swap {
+                        split(
+                            s,
+                            (&from_b, &arc_b, rb),
+                            (&from_a, &arc_a, ra),
+                            k,
+                            *strict,
+                            *budget,
+                        )
+                    } else {
+                        split(
+                            s,
+                            (&from_a, &arc_a, ra),
+                            (&from_b, &arc_b, rb),
+                            k,
+                            *strict,
+                            *budget,
+                        )
+                    };
+                    let Some((x, y, mut order)) = found else {
+                        continue;
+                    };
+                    if swap {
+                        for c in &mut order {
+                            c.second = !c.second;
+                        }
+                        return Some((y, x, order));
+                    }
+                    return Some((x, y, order));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// How many catoms of one loop's rest [`transport_pair`] may place
+/// before the other's arc joins it: beyond that the first loop hangs
+/// nearly complete on its connector anyway, and the failing searches
+/// cost seconds each.
+const PAIR_EARLY: usize = 3;
+
+/// One try of [`transport_pair`]: `x`'s arc and the first `k` cells of
+/// its rest, then `y`'s arc (the joint), then the rest of both, which
+/// wait for the joint. Each side is (source cells, arc, rest).
+fn split(
+    scene: &Scene,
+    x: (&[Cell; 10], &[Cell], &[Cell]),
+    y: (&[Cell; 10], &[Cell], &[Cell]),
+    k: usize,
+    strict: bool,
+    budget: usize,
+) -> Option<PairPaths> {
+    if k > x.2.len() {
+        return None;
+    }
+    let left = |t: &Scene, from: &[Cell; 10]| -> Vec<Cell> {
+        from.iter()
+            .copied()
+            .filter(|c| t.at.contains_key(c))
+            .collect()
+    };
+    let mut t = scene.clone();
+    let mut px = move_catoms(&mut t, x.0, x.1, strict, budget).ok()?;
+    let from = left(&t, x.0);
+    px.extend(move_catoms(&mut t, &from, &x.2[..k], strict, budget).ok()?);
+    let py = move_catoms(&mut t, y.0, y.1, strict, budget).ok()?;
+    let from = left(&t, x.0);
+    let rx = move_catoms(&mut t, &from, &x.2[k..], strict, budget).ok()?;
+    let from = left(&t, y.0);
+    let ry = move_catoms(&mut t, &from, y.2, strict, budget).ok()?;
+    let met = vec![px.len() - 1, px.len() + py.len() - 1];
+    let mut order = Vec::new();
+    let mut push = |second: bool, range: std::ops::Range<usize>, after: &[usize]| {
+        for index in range {
+            order.push(PairCommit {
+                second,
+                index,
+                after: after.to_vec(),
+            });
+        }
+    };
+    push(false, 0..px.len(), &[]);
+    push(true, 0..py.len(), &[]);
+    push(false, px.len()..px.len() + rx.len(), &met);
+    push(true, py.len()..py.len() + ry.len(), &met);
+    let lane_x = px.into_iter().chain(rx).collect();
+    let lane_y = py.into_iter().chain(ry).collect();
+    Some((lane_x, lane_y, order))
 }
 
 /// Vertex-disjoint source → destination paths of maximum number.
@@ -658,5 +1073,109 @@ fn emit(scene: &mut Scene, steps: Vec<Vec<Hop>>, lanes_at: Vec<usize>, out: &mut
         }
         out.streamlines_at.push(lanes);
         out.steps.push(events);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::{FccLattice, Lattice};
+
+    /// The side joints of two meta-modules of the C's top arm, found here
+    /// by scanning every pair of cells: the arc runs from the cell that
+    /// touches the holder to the cell that touches the partner, each cell
+    /// touching the one before, and the rest closes the loop.
+    #[test]
+    fn a_pair_s_loop_grows_from_its_holder_to_its_partner_along_the_loop() {
+        let touching = |c: Cell, m: Meta| {
+            m.sparse_cells()
+                .iter()
+                .any(|x| FccLattice.are_neighbours(c, *x))
+        };
+        // Z even: the two joints are opposite on the loop; Z odd: one cell
+        // touches both.
+        for (e, holder, partner, arc_len) in [
+            (
+                Meta::new(1, 2, 4),
+                Meta::new(1, 1, 4),
+                Meta::new(0, 2, 4),
+                6,
+            ),
+            (
+                Meta::new(0, 2, 4),
+                Meta::new(0, 1, 4),
+                Meta::new(1, 2, 4),
+                6,
+            ),
+            (
+                Meta::new(1, 3, 5),
+                Meta::new(1, 2, 5),
+                Meta::new(0, 3, 5),
+                1,
+            ),
+            (
+                Meta::new(0, 2, 0),
+                Meta::new(0, 1, 0),
+                Meta::new(1, 2, 0),
+                6,
+            ),
+        ] {
+            let (arc, rest) = arcs(e, holder, partner).expect("side neighbours");
+            assert_eq!(arc.len(), arc_len, "{e}");
+            assert!(touching(arc[0], holder) && touching(arc[arc.len() - 1], partner));
+            let whole: Vec<Cell> = arc.iter().chain(&rest).copied().collect();
+            let mut sorted = whole.clone();
+            sorted.sort_by_key(|c| (c.x, c.y, c.z));
+            let mut cells = e.sparse_cells().to_vec();
+            cells.sort_by_key(|c| (c.x, c.y, c.z));
+            assert_eq!(sorted, cells, "{e}: every cell once");
+            // Each catom latches to one already placed.
+            for i in 1..whole.len() {
+                assert!(
+                    whole[..i]
+                        .iter()
+                        .any(|c| FccLattice.are_neighbours(*c, whole[i])),
+                    "{e}: cell {i}"
+                );
+            }
+            // Only the arc's ends touch the holder and the partner.
+            assert_eq!(whole.iter().filter(|c| touching(**c, holder)).count(), 1);
+            assert_eq!(whole.iter().filter(|c| touching(**c, partner)).count(), 1);
+        }
+        // Stacked meta-modules touch through four cells: no arc.
+        assert!(arcs(Meta::new(0, 0, 1), Meta::new(0, 0, 0), Meta::new(1, 0, 1)).is_none());
+    }
+
+    /// Two goal cells that would each hang on one side connector go to
+    /// streamlines together or not at all; a single goal cell is served
+    /// instead when only one source can move, and with nothing else the
+    /// paper's destinations stay open.
+    #[test]
+    fn the_paired_order_serves_a_hanging_pair_both_or_neither() {
+        let m = Meta::new;
+        let mut state: BTreeMap<Meta, State> = BTreeMap::new();
+        for x in [-1, 0, 1, 2] {
+            state.insert(m(x, 0, 0), State::Sparse);
+        }
+        state.insert(m(0, 0, 1), State::Sparse);
+        state.insert(m(1, 0, 1), State::Sparse);
+        let (a, b, floor_cell) = (m(0, 1, 1), m(1, 1, 1), m(1, 1, 0));
+        let dest = [(m(0, 0, 1), a), (m(1, 0, 1), b), (m(1, 0, 0), floor_cell)];
+        let partners = |e: Meta| -> Vec<Meta> {
+            match e {
+                e if e == a => vec![b],
+                e if e == b => vec![a],
+                _ => Vec::new(),
+            }
+        };
+        let reach: FxHashMap<Meta, usize> = [(a, 3), (b, 3), (floor_cell, 2)].into_iter().collect();
+        let both = [m(-1, 0, 0), m(2, 0, 0)];
+        let chosen = paired_first(&state, &both, &dest, &partners, &reach);
+        assert_eq!(chosen, vec![dest[0], dest[1]], "two sources: the pair");
+        let one = [m(2, 0, 0)];
+        let chosen = paired_first(&state, &one, &dest, &partners, &reach);
+        assert_eq!(chosen, vec![dest[2]], "one source: not half a pair");
+        let chosen = paired_first(&state, &one, &dest[..2], &partners, &reach);
+        assert_eq!(chosen, dest[..2].to_vec(), "nothing else: the paper's");
     }
 }
