@@ -308,6 +308,23 @@ mod tests {
         }
     }
 
+    /// A scene of catoms in `cells`, the first one fixed.
+    fn fixed_first(cells: &[Cell]) -> Scene {
+        let mut before = Scene {
+            at: FxHashMap::default(),
+            fixed: FxHashSet::default(),
+            ground: None,
+            lo: c(-5, -5),
+            hi: c(5, 5),
+            region: None,
+        };
+        for (i, x) in cells.iter().enumerate() {
+            before.insert(i as ModuleId, *x);
+        }
+        before.fixed.insert(0);
+        before
+    }
+
     /// The catoms at rest at the start of each step, movers lifted, all
     /// reach the fixed catom (a breadth-first search written here).
     fn every_step_anchored(before: &Scene, steps: &[Vec<Hop>]) -> Vec<bool> {
@@ -345,18 +362,7 @@ mod tests {
     #[test]
     fn a_commit_waits_for_the_arrivals_it_names() {
         let [f, a, b] = [(0, 0), (1, 0), (-1, 0)].map(|(x, y)| c(x, y));
-        let mut before = Scene {
-            at: FxHashMap::default(),
-            fixed: FxHashSet::default(),
-            ground: None,
-            lo: c(-5, -5),
-            hi: c(5, 5),
-            region: None,
-        };
-        for (i, x) in [f, a, b].into_iter().enumerate() {
-            before.insert(i as ModuleId, x);
-        }
-        before.fixed.insert(0);
+        let before = fixed_first(&[f, a, b]);
         let first = Commit {
             lane: 0,
             path: vec![hop(a, c(0, 1), f)],
@@ -395,18 +401,7 @@ mod tests {
             (-1, 0),
         ]
         .map(|(x, y)| c(x, y));
-        let mut before = Scene {
-            at: FxHashMap::default(),
-            fixed: FxHashSet::default(),
-            ground: None,
-            lo: c(-5, -5),
-            hi: c(5, 5),
-            region: None,
-        };
-        for (i, x) in [f, k, m, z, r, r2, s, m0].into_iter().enumerate() {
-            before.insert(i as ModuleId, x);
-        }
-        before.fixed.insert(0);
+        let before = fixed_first(&[f, k, m, z, r, r2, s, m0]);
         let lane1 = vec![vec![hop(m0, c(0, -1), f)], vec![hop(m, c(1, -1), f)]];
         let z_path = vec![hop(z, c(1, 2), k), hop(c(1, 2), c(0, 2), k)];
         let p = pipeline(&before, &[lane1, vec![z_path.clone()]], &Free)

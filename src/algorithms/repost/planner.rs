@@ -1094,31 +1094,12 @@ mod tests {
         };
         // Z even: the two joints are opposite on the loop; Z odd: one cell
         // touches both.
+        let m = Meta::new;
         for (e, holder, partner, arc_len) in [
-            (
-                Meta::new(1, 2, 4),
-                Meta::new(1, 1, 4),
-                Meta::new(0, 2, 4),
-                6,
-            ),
-            (
-                Meta::new(0, 2, 4),
-                Meta::new(0, 1, 4),
-                Meta::new(1, 2, 4),
-                6,
-            ),
-            (
-                Meta::new(1, 3, 5),
-                Meta::new(1, 2, 5),
-                Meta::new(0, 3, 5),
-                1,
-            ),
-            (
-                Meta::new(0, 2, 0),
-                Meta::new(0, 1, 0),
-                Meta::new(1, 2, 0),
-                6,
-            ),
+            (m(1, 2, 4), m(1, 1, 4), m(0, 2, 4), 6),
+            (m(0, 2, 4), m(0, 1, 4), m(1, 2, 4), 6),
+            (m(1, 3, 5), m(1, 2, 5), m(0, 3, 5), 1),
+            (m(0, 2, 0), m(0, 1, 0), m(1, 2, 0), 6),
         ] {
             let (arc, rest) = arcs(e, holder, partner).expect("side neighbours");
             assert_eq!(arc.len(), arc_len, "{e}");
