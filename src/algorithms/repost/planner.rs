@@ -1092,8 +1092,8 @@ mod tests {
                 .iter()
                 .any(|x| FccLattice.are_neighbours(c, *x))
         };
-        // Z even: the two joints are opposite on the loop; Z odd: one cell
-        // touches both.
+        // In the rows next to the C's spine the two joints are opposite on
+        // the loop; in the tip row (x, 3, 5) one cell touches both.
         let m = Meta::new;
         for (e, holder, partner, arc_len) in [
             (m(1, 2, 4), m(1, 1, 4), m(0, 2, 4), 6),
