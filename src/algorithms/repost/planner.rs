@@ -694,8 +694,9 @@ fn transport(
 
 /// The destinations of a `GoalOrder::Paired` iteration, chosen greedily
 /// (the sets of destinations that vertex-disjoint streamlines can serve
-/// together form a matroid, a gammoid, so the greedy choice serves as
-/// many as the plain maximum flow): first each pair of cells that would
+/// together form a matroid, a gammoid, so the choice is maximal; a pair
+/// taken only whole can leave a cell unserved that the plain maximum
+/// flow would serve): first each pair of cells that would
 /// hang on one side connector alone, both or neither; then the other
 /// cells, those farthest from the coordinator first (the arms' far rows
 /// get their holders while sources remain to assemble them as pairs). A
