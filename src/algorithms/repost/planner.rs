@@ -209,6 +209,18 @@ fn within<'a>(
     s
 }
 
+/// Whether meta-module `n` stays through an iteration with these
+/// `sources`: a SPARSE one unless it is a source (it leaves while the
+/// iteration's goal cells are assembled), a FULL one always (only its
+/// filling leaves; it stays, SPARSE).
+fn stays(state: &BTreeMap<Meta, State>, sources: &[Meta], n: &Meta) -> bool {
+    match state.get(n) {
+        Some(State::Sparse) => !sources.contains(n),
+        Some(State::Full) => true,
+        _ => false,
+    }
+}
+
 /// The global coordinator: the lowest meta-module in both shapes.
 fn coordinator(initial: &BTreeMap<Meta, State>, goal: &BTreeMap<Meta, State>) -> Option<Meta> {
     initial
@@ -288,7 +300,7 @@ fn plan_with(
     let floor = initial.keys().map(|m| m.z).min().unwrap_or(0);
     // Each goal cell's distance from the coordinator inside the goal.
     let reach = spanning_tree(|m| goal.contains_key(m), gc).depth;
-    let ground = 4 * initial.keys().map(|m| m.z).min().unwrap_or(0);
+    let ground = 4 * floor;
     let mut scene = Scene::new(Some(ground));
     let mut modules = Vec::new();
     for (m, st) in initial {
@@ -373,18 +385,11 @@ fn plan_with(
                 goal.contains_key(d) && state.get(d) == Some(&State::Sparse) && !taken.contains(d)
             });
             let chosen = if matches!(order, GoalOrder::Supported | GoalOrder::Paired) {
-                // The first of the best, so ties keep the paper's choice;
-                // this iteration's SPARSE sources leave while `e` is
-                // assembled (a FULL one stays, SPARSE).
-                let stays = |n: &Meta| match state.get(n) {
-                    Some(State::Sparse) => !sources.contains(n),
-                    Some(State::Full) => true,
-                    _ => false,
-                };
+                // The first of the best, so ties keep the paper's choice.
                 let held = |d: &Meta| {
                     let rest: usize = d
                         .adjacent()
-                        .filter(|n| n != e && stays(n))
+                        .filter(|n| n != e && stays(&state, &sources, n))
                         .map(|n| d.joints(n))
                         .sum();
                     (d.joints(*e), rest)
@@ -428,12 +433,11 @@ fn plan_with(
             if order != GoalOrder::Paired || e.z == floor || present.contains_key(&e) {
                 return Vec::new();
             }
-            let stays = |n: &Meta| match present.get(n) {
-                Some(State::Sparse) => !sources.contains(n),
-                Some(State::Full) => true,
-                _ => false,
-            };
-            let held: usize = e.adjacent().filter(stays).map(|n| e.joints(n)).sum();
+            let held: usize = e
+                .adjacent()
+                .filter(|n| stays(&present, &sources, n))
+                .map(|n| e.joints(n))
+                .sum();
             if held > 1 {
                 return Vec::new();
             }
@@ -874,56 +878,42 @@ fn transport_pair(
         (backwards(&rest_a), rest_b.clone()),
     ];
     // The regions of `transport`, widening; in each, strictly first.
-    let tries: Vec<(Scene, bool, usize)> = [Some(0), Some(1), None]
+    let all: Vec<Cell> = a
+        .sparse_cells()
         .into_iter()
-        .map(|m| (SEARCH_BUDGET, m))
-        .flat_map(|(budget, margin)| {
-            let all: Vec<Cell> = a
-                .sparse_cells()
-                .into_iter()
-                .chain(b.sparse_cells())
-                .collect();
+        .chain(b.sparse_cells())
+        .collect();
+    let tries: Vec<(Scene, bool)> = [Some(0), Some(1), None]
+        .into_iter()
+        .flat_map(|margin| {
             let metas = line_a.iter().chain(line_b).chain([&a, &b]);
             let s = within(scene, metas, margin, &all);
-            [true, false].map(|strict| (s.clone(), strict, budget))
+            [true, false].map(|strict| (s.clone(), strict))
         })
         .collect();
     // The fewest catoms of one loop before the other's arc joins it (none
     // beyond its own arc if the paths allow, at most `PAIR_EARLY` more),
     // in any region; else each is transported alone.
     for k in 0..=PAIR_EARLY {
-        for (s, strict, budget) in &tries {
+        for (s, strict) in &tries {
             for swap in [false, true] {
                 for (ra, rb) in &rests {
-                    let found = if swap {
-                        split(
-                            s,
-                            (&from_b, &arc_b, rb),
-                            (&from_a, &arc_a, ra),
-                            k,
-                            *strict,
-                            *budget,
-                        )
-                    } else {
-                        split(
-                            s,
-                            (&from_a, &arc_a, ra),
-                            (&from_b, &arc_b, rb),
-                            k,
-                            *strict,
-                            *budget,
-                        )
-                    };
-                    let Some((x, y, mut order)) = found else {
+                    let (x, y) = (
+                        (&from_a, &arc_a[..], &ra[..]),
+                        (&from_b, &arc_b[..], &rb[..]),
+                    );
+                    let (x, y) = if swap { (y, x) } else { (x, y) };
+                    let Some((px, py, mut order)) = split(s, x, y, k, *strict, SEARCH_BUDGET)
+                    else {
                         continue;
                     };
                     if swap {
                         for c in &mut order {
                             c.second = !c.second;
                         }
-                        return Some((y, x, order));
+                        return Some((py, px, order));
                     }
-                    return Some((x, y, order));
+                    return Some((px, py, order));
                 }
             }
         }
