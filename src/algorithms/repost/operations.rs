@@ -184,11 +184,44 @@ pub fn move_catoms(
     strict: bool,
     budget: usize,
 ) -> Result<Vec<Vec<Hop>>, Cell> {
+    search_moves(s, sources, targets, strict, budget, false, false)
+}
+
+/// [`move_catoms`] with the targets filled strictly in their order (a
+/// chain grown from its first cell, each catom latching to the one
+/// before, never from its far end inwards); with `top_first`, each by
+/// the highest source catom that reaches it, then the shortest path: a
+/// source is taken down from its top, so that what stays of it stands on
+/// what is below while the chain grows (the catoms of a source on the
+/// ground that leave first from its bottom leave the rest hanging on its
+/// side joints).
+pub fn move_catoms_in_order(
+    s: &mut Scene,
+    sources: &[Cell],
+    targets: &[Cell],
+    strict: bool,
+    budget: usize,
+    top_first: bool,
+) -> Result<Vec<Vec<Hop>>, Cell> {
+    search_moves(s, sources, targets, strict, budget, true, top_first)
+}
+
+fn search_moves(
+    s: &mut Scene,
+    sources: &[Cell],
+    targets: &[Cell],
+    strict: bool,
+    budget: usize,
+    in_order: bool,
+    top_first: bool,
+) -> Result<Vec<Vec<Hop>>, Cell> {
     assert!(sources.len() <= 32 && targets.len() <= 32);
     let mut search = Dfs {
         sources,
         targets,
         strict,
+        in_order,
+        top_first,
         failed: FxHashSet::default(),
         budget,
         paths: Vec::new(),
@@ -229,6 +262,10 @@ struct Dfs<'a> {
     sources: &'a [Cell],
     targets: &'a [Cell],
     strict: bool,
+    /// Only the first target not yet filled is open.
+    in_order: bool,
+    /// The highest source catom first, then the shortest path.
+    top_first: bool,
     failed: FxHashSet<(u32, u32)>,
     budget: usize,
     paths: Vec<Vec<Hop>>,
@@ -255,6 +292,7 @@ impl Dfs<'_> {
             .enumerate()
             .filter(|(i, _)| placed & (1 << i) == 0)
             .map(|(i, c)| (i, *c))
+            .take(if self.in_order { 1 } else { n })
             .collect();
         let goals: Vec<Cell> = open.iter().map(|x| x.1).collect();
         let mut cands = Vec::new();
@@ -268,7 +306,11 @@ impl Dfs<'_> {
                 }
             }
         }
-        cands.sort_by_key(|c| (c.0, c.1, c.2, c.3));
+        if self.top_first {
+            cands.sort_by_key(|c| (c.0, c.2, c.1, c.3));
+        } else {
+            cands.sort_by_key(|c| (c.0, c.1, c.2, c.3));
+        }
         for (ti, _, _, si, p) in cands {
             let (from, to) = (self.sources[si], self.targets[ti]);
             let id = s.at.remove(&from).expect("a source cell holds a catom");
@@ -349,4 +391,58 @@ fn plan(
         strict,
         order: "",
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lattice::{FccLattice, Lattice};
+
+    /// A 5 × 5 patch on the ground with two removable corner catoms, and
+    /// two goal cells: `b` on the patch, `a` on `b` alone (one layer
+    /// higher, so it touches nothing else). `a` is reachable only once
+    /// `b` holds a catom to pivot on.
+    fn patch_with_a_chain() -> (Scene, [Cell; 2], Cell, Cell) {
+        let mut s = Scene::new(Some(0));
+        let mut id = 0;
+        for x in 0..5 {
+            for y in 0..5 {
+                s.insert(id, Cell::new(x, y, 0));
+                id += 1;
+            }
+        }
+        s.fit_box(&[], 3);
+        let b = FccLattice
+            .neighbours(Cell::new(2, 2, 0))
+            .into_iter()
+            .find(|c| c.z == 1)
+            .expect("a cell above");
+        let a = FccLattice
+            .neighbours(b)
+            .into_iter()
+            .find(|c| c.z == 2)
+            .expect("a cell above that");
+        (s, [Cell::new(0, 0, 0), Cell::new(4, 4, 0)], a, b)
+    }
+
+    /// Unordered, the search fills the goal it can reach first and comes
+    /// back for the other; in order, a chain is grown only from its first
+    /// cell, and a first cell nothing can reach yet is where it stops.
+    #[test]
+    fn a_chain_in_order_is_grown_from_its_first_cell_or_not_at_all() {
+        let (s, sources, a, b) = patch_with_a_chain();
+        let paths = move_catoms(&mut s.clone(), &sources, &[a, b], true, SEARCH_BUDGET)
+            .expect("b, then a on it");
+        let ends: Vec<Cell> = paths.iter().map(|p| p[p.len() - 1].to).collect();
+        assert_eq!(ends, [b, a], "unordered: the far end first");
+        assert_eq!(
+            move_catoms_in_order(&mut s.clone(), &sources, &[a, b], true, SEARCH_BUDGET, true),
+            Err(a)
+        );
+        let paths =
+            move_catoms_in_order(&mut s.clone(), &sources, &[b, a], true, SEARCH_BUDGET, true)
+                .expect("in its own order the chain grows");
+        let ends: Vec<Cell> = paths.iter().map(|p| p[p.len() - 1].to).collect();
+        assert_eq!(ends, [b, a]);
+    }
 }

@@ -31,7 +31,9 @@
 
 use super::messages::{self, IterationRecord, Messages};
 use super::metamodule::{Meta, State, spanning_tree};
-use super::operations::{DEEP_SEARCH_BUDGET, FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms};
+use super::operations::{
+    DEEP_SEARCH_BUDGET, FILL_SEARCH_BUDGET, SEARCH_BUDGET, move_catoms, move_catoms_in_order,
+};
 use super::pipeline::{Commit, pipeline_commits};
 use super::search::{Hop, Scene};
 use crate::geometry::MotionRules;
@@ -124,11 +126,16 @@ pub enum GoalOrder {
     /// that would hang on one side connector (no other joint to what
     /// stays) is assembled together with a side neighbour in the goal,
     /// each loop grown from its holder towards the other along the
-    /// shorter arc, and neither completed before the two arcs have met
+    /// shorter arc (either way where the joints are opposite), catom by
+    /// catom in the arc's order, and neither completed before the two
+    /// arcs have met
     /// (a SPARSE meta-module alone on one connector along Y breaks it at
     /// 100 kPa; the pair holds with margin: `docs/repost.md`). A cell
     /// whose partner gets no streamline in an iteration waits for one,
-    /// unless nothing else would move.
+    /// unless nothing else would move. Every goal loop is filled from its
+    /// lowest cells, and a pair's arcs take their source's highest
+    /// catoms first, so that nothing hangs by its side joints while it
+    /// grows or is taken down (the L → C-20 certifies at 100 kPa).
     Paired,
 }
 
@@ -532,7 +539,8 @@ fn plan_with(
                 }
                 let line = line.clone();
                 let fill = goal_meta == *line.last().expect("a streamline has an end");
-                match transport(&scene, &line, state[&src], goal_meta, fill) {
+                let lowest_first = order == GoalOrder::Paired;
+                match transport(&scene, &line, state[&src], goal_meta, fill, lowest_first) {
                     Ok(paths) => {
                         // The next streamline plans against this one's end state.
                         for p in &paths {
@@ -649,6 +657,7 @@ fn transport(
     source: State,
     goal_meta: Meta,
     fill: bool,
+    lowest_first: bool,
 ) -> Result<Vec<Vec<Hop>>, Cell> {
     // A FULL source gives its ten filling catoms; a SPARSE one its loop.
     let from = if source == State::Full {
@@ -668,6 +677,14 @@ fn transport(
             .into_iter()
             .map(|(_, o)| o)
             .collect()
+    } else if lowest_first {
+        // `Paired`: the lowest cells first (in loop order within a
+        // layer), so that a loop reaches what is below it, the ground or
+        // the meta-module under it, before it grows far from its joint;
+        // where no catom finds that order, the loop's own.
+        let mut t = targets.to_vec();
+        t.sort_by_key(|c| c.z);
+        vec![t, targets.to_vec()]
     } else {
         vec![targets.to_vec()]
     };
@@ -808,9 +825,10 @@ fn commit_order(
 
 /// The loop of `e` split for a pair: the arc from its cell joined to
 /// `holder` to its cell joined to `partner`, the shorter way round (both
-/// ends included), then the rest of the loop onwards from the arc's end.
-/// `None` unless each is joined by exactly one cell (side neighbours).
-fn arcs(e: Meta, holder: Meta, partner: Meta) -> Option<(Vec<Cell>, Vec<Cell>)> {
+/// ends included; both ways where the two joints are opposite on the
+/// loop), then the rest of the loop onwards from the arc's end. Empty
+/// unless each is joined by exactly one cell (side neighbours).
+fn arcs(e: Meta, holder: Meta, partner: Meta) -> Vec<(Vec<Cell>, Vec<Cell>)> {
     use crate::lattice::{FccLattice, Lattice};
     let cells = e.sparse_cells();
     let joined = |m: Meta| {
@@ -823,32 +841,43 @@ fn arcs(e: Meta, holder: Meta, partner: Meta) -> Option<(Vec<Cell>, Vec<Cell>)> 
         let i = at.next()?;
         at.next().is_none().then_some(i)
     };
-    let (a, b) = (joined(holder)?, joined(partner)?);
+    let (Some(a), Some(b)) = (joined(holder), joined(partner)) else {
+        return Vec::new();
+    };
     let forward = (b + 10 - a) % 10;
-    let step = if forward <= 5 { 1 } else { 9 };
-    let mut arc = vec![a];
-    let mut i = a;
-    while i != b {
-        i = (i + step) % 10;
-        arc.push(i);
-    }
-    let mut rest = Vec::new();
-    i = (b + step) % 10;
-    while i != a {
-        rest.push(i);
-        i = (i + step) % 10;
-    }
-    let order: Vec<usize> = arc.iter().chain(&rest).copied().collect();
-    // Each catom latches the one before it (the loop's own order).
-    let linked = order
-        .windows(2)
-        .all(|w| w[1] == arc[0] || FccLattice.are_neighbours(cells[w[0]], cells[w[1]]));
-    linked.then(|| {
-        (
-            arc.iter().map(|&i| cells[i]).collect(),
-            rest.iter().map(|&i| cells[i]).collect(),
-        )
-    })
+    let steps: &[usize] = match forward {
+        5 => &[1, 9],
+        f if f < 5 => &[1],
+        _ => &[9],
+    };
+    steps
+        .iter()
+        .filter_map(|&step| {
+            let mut arc = vec![a];
+            let mut i = a;
+            while i != b {
+                i = (i + step) % 10;
+                arc.push(i);
+            }
+            let mut rest = Vec::new();
+            i = (b + step) % 10;
+            while i != a {
+                rest.push(i);
+                i = (i + step) % 10;
+            }
+            let order: Vec<usize> = arc.iter().chain(&rest).copied().collect();
+            // Each catom latches the one before it (the loop's own order).
+            let linked = order
+                .windows(2)
+                .all(|w| w[1] == arc[0] || FccLattice.are_neighbours(cells[w[0]], cells[w[1]]));
+            linked.then(|| {
+                (
+                    arc.iter().map(|&i| cells[i]).collect(),
+                    rest.iter().map(|&i| cells[i]).collect(),
+                )
+            })
+        })
+        .collect()
 }
 
 /// Two SPARSE goal meta-modules side by side, each hanging on one side
@@ -865,18 +894,25 @@ fn transport_pair(
     line_b: &[Meta],
     b: Meta,
 ) -> Option<PairPaths> {
-    let (arc_a, rest_a) = arcs(a, *line_a.last()?, b)?;
-    let (arc_b, rest_b) = arcs(b, *line_b.last()?, a)?;
+    let (arcs_a, arcs_b) = (arcs(a, *line_a.last()?, b), arcs(b, *line_b.last()?, a));
     let (from_a, from_b) = (line_a[0].sparse_cells(), line_b[0].sparse_cells());
-    // Each rest may be grown from either end of its arc: from the
-    // partner's joint onwards or from the holder's joint back.
+    // Either way round where the joints are opposite, and each rest
+    // grown from either end of its arc: from the partner's joint onwards
+    // or from the holder's joint back.
     let backwards = |r: &[Cell]| r.iter().rev().copied().collect::<Vec<Cell>>();
-    let rests = [
-        (rest_a.clone(), rest_b.clone()),
-        (backwards(&rest_a), backwards(&rest_b)),
-        (rest_a.clone(), backwards(&rest_b)),
-        (backwards(&rest_a), rest_b.clone()),
-    ];
+    let mut splits: Vec<[Vec<Cell>; 4]> = Vec::new();
+    for (arc_a, rest_a) in &arcs_a {
+        for (arc_b, rest_b) in &arcs_b {
+            for (ra, rb) in [
+                (rest_a.clone(), rest_b.clone()),
+                (backwards(rest_a), backwards(rest_b)),
+                (rest_a.clone(), backwards(rest_b)),
+                (backwards(rest_a), rest_b.clone()),
+            ] {
+                splits.push([arc_a.clone(), ra, arc_b.clone(), rb]);
+            }
+        }
+    }
     // The regions of `transport`, widening; in each, strictly first.
     let all: Vec<Cell> = a
         .sparse_cells()
@@ -894,26 +930,31 @@ fn transport_pair(
     // The fewest catoms of one loop before the other's arc joins it (none
     // beyond its own arc if the paths allow, at most `PAIR_EARLY` more),
     // in any region; else each is transported alone.
-    for k in 0..=PAIR_EARLY {
-        for (s, strict) in &tries {
-            for swap in [false, true] {
-                for (ra, rb) in &rests {
-                    let (x, y) = (
-                        (&from_a, &arc_a[..], &ra[..]),
-                        (&from_b, &arc_b[..], &rb[..]),
-                    );
-                    let (x, y) = if swap { (y, x) } else { (x, y) };
-                    let Some((px, py, mut order)) = split(s, x, y, k, *strict, SEARCH_BUDGET)
-                    else {
-                        continue;
-                    };
-                    if swap {
-                        for c in &mut order {
-                            c.second = !c.second;
+    // Each source taken down from its top where that finds a split,
+    // else by the shortest paths.
+    for top_first in [true, false] {
+        for k in 0..=PAIR_EARLY {
+            for (s, strict) in &tries {
+                for swap in [false, true] {
+                    for [arc_a, ra, arc_b, rb] in &splits {
+                        let (x, y) = (
+                            (&from_a, &arc_a[..], &ra[..]),
+                            (&from_b, &arc_b[..], &rb[..]),
+                        );
+                        let (x, y) = if swap { (y, x) } else { (x, y) };
+                        let Some((px, py, mut order)) =
+                            split(s, x, y, k, *strict, SEARCH_BUDGET, top_first)
+                        else {
+                            continue;
+                        };
+                        if swap {
+                            for c in &mut order {
+                                c.second = !c.second;
+                            }
+                            return Some((py, px, order));
                         }
-                        return Some((py, px, order));
+                        return Some((px, py, order));
                     }
-                    return Some((px, py, order));
                 }
             }
         }
@@ -937,6 +978,7 @@ fn split(
     k: usize,
     strict: bool,
     budget: usize,
+    top_first: bool,
 ) -> Option<PairPaths> {
     if k > x.2.len() {
         return None;
@@ -947,11 +989,17 @@ fn split(
             .filter(|c| t.at.contains_key(c))
             .collect()
     };
+    // Until the two arcs meet, each grows strictly in its order from its
+    // holder's joint: a cell filled out of order would hang its catom,
+    // and those after it, on whatever it touches first, the other
+    // loop's tip (both loops, twelve catoms, on one connector). After
+    // the joint the rests may fill in any order: both loops are held at
+    // both ends.
     let mut t = scene.clone();
-    let mut px = move_catoms(&mut t, x.0, x.1, strict, budget).ok()?;
+    let mut px = move_catoms_in_order(&mut t, x.0, x.1, strict, budget, top_first).ok()?;
     let from = left(&t, x.0);
-    px.extend(move_catoms(&mut t, &from, &x.2[..k], strict, budget).ok()?);
-    let py = move_catoms(&mut t, y.0, y.1, strict, budget).ok()?;
+    px.extend(move_catoms_in_order(&mut t, &from, &x.2[..k], strict, budget, top_first).ok()?);
+    let py = move_catoms_in_order(&mut t, y.0, y.1, strict, budget, top_first).ok()?;
     let from = left(&t, x.0);
     let rx = move_catoms(&mut t, &from, &x.2[k..], strict, budget).ok()?;
     let from = left(&t, y.0);
@@ -1092,30 +1140,37 @@ mod tests {
             (m(1, 3, 5), m(1, 2, 5), m(0, 3, 5), 1),
             (m(0, 2, 0), m(0, 1, 0), m(1, 2, 0), 6),
         ] {
-            let (arc, rest) = arcs(e, holder, partner).expect("side neighbours");
-            assert_eq!(arc.len(), arc_len, "{e}");
-            assert!(touching(arc[0], holder) && touching(arc[arc.len() - 1], partner));
-            let whole: Vec<Cell> = arc.iter().chain(&rest).copied().collect();
-            let mut sorted = whole.clone();
-            sorted.sort_by_key(|c| (c.x, c.y, c.z));
-            let mut cells = e.sparse_cells().to_vec();
-            cells.sort_by_key(|c| (c.x, c.y, c.z));
-            assert_eq!(sorted, cells, "{e}: every cell once");
-            // Each catom latches to one already placed.
-            for i in 1..whole.len() {
-                assert!(
-                    whole[..i]
-                        .iter()
-                        .any(|c| FccLattice.are_neighbours(*c, whole[i])),
-                    "{e}: cell {i}"
-                );
+            let ways = arcs(e, holder, partner);
+            assert_eq!(
+                ways.len(),
+                if arc_len == 6 { 2 } else { 1 },
+                "{e}: both ways when opposite"
+            );
+            for (arc, rest) in ways {
+                assert_eq!(arc.len(), arc_len, "{e}");
+                assert!(touching(arc[0], holder) && touching(arc[arc.len() - 1], partner));
+                let whole: Vec<Cell> = arc.iter().chain(&rest).copied().collect();
+                let mut sorted = whole.clone();
+                sorted.sort_by_key(|c| (c.x, c.y, c.z));
+                let mut cells = e.sparse_cells().to_vec();
+                cells.sort_by_key(|c| (c.x, c.y, c.z));
+                assert_eq!(sorted, cells, "{e}: every cell once");
+                // Each catom latches to one already placed.
+                for i in 1..whole.len() {
+                    assert!(
+                        whole[..i]
+                            .iter()
+                            .any(|c| FccLattice.are_neighbours(*c, whole[i])),
+                        "{e}: cell {i}"
+                    );
+                }
+                // Only the arc's ends touch the holder and the partner.
+                assert_eq!(whole.iter().filter(|c| touching(**c, holder)).count(), 1);
+                assert_eq!(whole.iter().filter(|c| touching(**c, partner)).count(), 1);
             }
-            // Only the arc's ends touch the holder and the partner.
-            assert_eq!(whole.iter().filter(|c| touching(**c, holder)).count(), 1);
-            assert_eq!(whole.iter().filter(|c| touching(**c, partner)).count(), 1);
         }
         // Stacked meta-modules touch through four cells: no arc.
-        assert!(arcs(Meta::new(0, 0, 1), Meta::new(0, 0, 0), Meta::new(1, 0, 1)).is_none());
+        assert!(arcs(Meta::new(0, 0, 1), Meta::new(0, 0, 0), Meta::new(1, 0, 1)).is_empty());
     }
 
     /// Two goal cells that would each hang on one side connector go to
