@@ -2,7 +2,7 @@
 //! sequence of real rotations that certifies clean (lattice, exact sweeps,
 //! mechanics under the default model, the structure resting on the ground).
 
-use reconfcheck::algorithms::repost::metamodule::{Direction, State};
+use reconfcheck::algorithms::repost::metamodule::{Direction, Meta, State};
 use reconfcheck::algorithms::repost::operation_schedule;
 use reconfcheck::algorithms::repost::operations::{self, Role};
 use reconfcheck::certify::{Options, World, certify};
@@ -226,7 +226,6 @@ fn ends_on_the_goal(s: &reconfcheck::schedule::Schedule, file: &str) {
 
 /// [`ends_on_the_goal`] for the shape file at `path`.
 fn ends_on(s: &reconfcheck::schedule::Schedule, path: &std::path::Path) {
-    use reconfcheck::algorithms::repost::metamodule::Meta;
     use reconfcheck::algorithms::repost::shape;
     let file = path.display();
     let goal = shape::load(path).unwrap();
@@ -665,7 +664,6 @@ fn the_papers_goal_order_fills_cells_above_empty_ones_and_needs_fewer_iterations
 /// Both plans end on the goal and certify collision-free.
 #[test]
 fn the_supported_goal_order_assembles_a_cell_from_its_best_held_neighbour() {
-    use reconfcheck::algorithms::repost::metamodule::Meta;
     let tag = "repost-supported";
     // Leaders of (0,0,0) (1,0,0) (0,0,1) (1,0,1) (1,1,1), then the
     // source (-1,0,0) or the goal cell (0,1,1).
@@ -731,7 +729,6 @@ fn the_supported_goal_order_assembles_a_cell_from_its_best_held_neighbour() {
 /// 0.939 — the overloads of the 28-meta-module L → C (`docs/repost.md`).
 #[test]
 fn a_sparse_meta_module_hangs_on_one_connector_from_a_side_neighbour_and_breaks_it_along_y() {
-    use reconfcheck::algorithms::repost::metamodule::Meta;
     use reconfcheck::certify::ViolationKind;
     use reconfcheck::lattice::{FccLattice, Lattice, LatticeKind};
     use reconfcheck::schedule::{Length, ModuleSpec, Schedule};
@@ -785,6 +782,27 @@ fn a_sparse_meta_module_hangs_on_one_connector_from_a_side_neighbour_and_breaks_
     assert!(ids.len() == 2 && ids.iter().any(|&i| i <= 10) && ids.iter().any(|&i| i > 10));
 }
 
+/// The meta-modules of the shape files `initial_file` and `goal_file`
+/// (`models/shapes/repost/`), and the goal's that are built (not in the
+/// initial shape) off the ground layer.
+fn built_off_the_floor(initial_file: &str, goal_file: &str) -> (Vec<Meta>, Vec<Meta>, Vec<Meta>) {
+    use reconfcheck::algorithms::repost::shape;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/shapes/repost");
+    let initial = shape::load(&dir.join(initial_file)).unwrap();
+    let goal = shape::load(&dir.join(goal_file)).unwrap();
+    let floor = initial.keys().map(|m| m.z).min().unwrap();
+    let built = goal
+        .keys()
+        .filter(|m| !initial.contains_key(m) && m.z != floor)
+        .copied()
+        .collect();
+    (
+        initial.into_keys().collect(),
+        goal.into_keys().collect(),
+        built,
+    )
+}
+
 /// For each goal meta-module that is built (not in `initial_file`) off
 /// the ground layer: the connectors from its loop to catoms outside it,
 /// counted from the lattice at the step its last catom arrives.
@@ -792,19 +810,10 @@ fn joints_at_completion(
     s: &reconfcheck::schedule::Schedule,
     initial_file: &str,
     goal_file: &str,
-) -> Vec<(reconfcheck::algorithms::repost::metamodule::Meta, usize)> {
-    use reconfcheck::algorithms::repost::shape;
+) -> Vec<(Meta, usize)> {
     use reconfcheck::lattice::{FccLattice, Lattice};
     use reconfcheck::schedule::Event;
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/shapes/repost");
-    let initial = shape::load(&dir.join(initial_file)).unwrap();
-    let goal = shape::load(&dir.join(goal_file)).unwrap();
-    let floor = initial.keys().map(|m| m.z).min().unwrap();
-    let mut open: Vec<_> = goal
-        .keys()
-        .filter(|m| !initial.contains_key(m) && m.z != floor)
-        .copied()
-        .collect();
+    let (_, _, mut open) = built_off_the_floor(initial_file, goal_file);
     let mut at: std::collections::HashSet<Cell> = s.modules.iter().map(|m| m.cell).collect();
     let mut out = Vec::new();
     for step in &s.steps {
@@ -843,21 +852,11 @@ fn loops_begun_on_an_unfinished_neighbour(
     s: &reconfcheck::schedule::Schedule,
     initial_file: &str,
     goal_file: &str,
-) -> Vec<reconfcheck::algorithms::repost::metamodule::Meta> {
-    use reconfcheck::algorithms::repost::metamodule::Meta;
-    use reconfcheck::algorithms::repost::shape;
+) -> Vec<Meta> {
     use reconfcheck::lattice::{FccLattice, Lattice};
     use reconfcheck::schedule::Event;
     use std::collections::{HashMap, HashSet};
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models/shapes/repost");
-    let initial = shape::load(&dir.join(initial_file)).unwrap();
-    let goal = shape::load(&dir.join(goal_file)).unwrap();
-    let floor = initial.keys().map(|m| m.z).min().unwrap();
-    let built: Vec<Meta> = goal
-        .keys()
-        .filter(|m| !initial.contains_key(m) && m.z != floor)
-        .copied()
-        .collect();
+    let (initial, goal, built) = built_off_the_floor(initial_file, goal_file);
     // The step at which each cell receives the catom that stays there.
     let mut last: HashMap<Cell, usize> = HashMap::new();
     for (k, step) in s.steps.iter().enumerate() {
@@ -878,8 +877,8 @@ fn loops_begun_on_an_unfinished_neighbour(
             (*m, (last[&c], c))
         })
         .collect();
-    let mut metas: HashSet<Meta> = initial.keys().chain(goal.keys()).copied().collect();
-    metas.extend(built.iter().flat_map(|m| m.adjacent()));
+    // A complete loop is one of the initial shape's or one built.
+    let metas: HashSet<Meta> = initial.into_iter().chain(goal).collect();
     let mut at: HashSet<Cell> = s.modules.iter().map(|m| m.cell).collect();
     let mut out = Vec::new();
     for (k, step) in s.steps.iter().enumerate() {
@@ -894,11 +893,10 @@ fn loops_begun_on_an_unfinished_neighbour(
                 continue;
             }
             let held = metas.iter().any(|n| {
+                let loop_ = n.sparse_cells();
                 n != m
-                    && n.sparse_cells().iter().all(|x| at.contains(x))
-                    && n.sparse_cells()
-                        .iter()
-                        .any(|x| FccLattice.are_neighbours(*x, c))
+                    && loop_.iter().all(|x| at.contains(x))
+                    && loop_.iter().any(|x| FccLattice.are_neighbours(*x, c))
             });
             if !held {
                 out.push(*m);

@@ -927,11 +927,11 @@ fn transport_pair(
             [true, false].map(|strict| (s.clone(), strict))
         })
         .collect();
-    // The fewest catoms of one loop before the other's arc joins it (none
-    // beyond its own arc if the paths allow, at most `PAIR_EARLY` more),
-    // in any region; else each is transported alone.
-    // Each source taken down from its top where that finds a split,
-    // else by the shortest paths.
+    // Each source taken down from its top where that finds a split, else
+    // by the shortest paths; then the fewest catoms of one loop before the
+    // other's arc joins it (none beyond its own arc if the paths allow, at
+    // most `PAIR_EARLY` more), in any region; else each is transported
+    // alone.
     for top_first in [true, false] {
         for k in 0..=PAIR_EARLY {
             for (s, strict) in &tries {
